@@ -184,6 +184,7 @@ class Driver:
         command: tuple[str, ...] = (),
         build: str = "gcc",
         big_buffer: bool = True,
+        defines: tuple[str, ...] = (),
     ) -> None:
         """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it;
         with `command` (a compiler and its flags: clang, gcc -m32) for `build` (BUILDS), else gcc; with the spec's
@@ -199,6 +200,7 @@ class Driver:
             "-std=c99",
             *sanitize,
             *big,
+            *defines,
             "-I",
             str(c.parent),
             f"-DPROTO={name}",
@@ -438,6 +440,31 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
     agree()
 
 
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_parser_without_its_whole_frame_path_gives_what_python_gives(g: Generated, tmp_path: Path) -> None:
+    """P_PARSER_WHOLE_FRAMES=0 (every byte through push, for the smallest flash): noisy streams in random pieces still
+    give the Python parser's messages and counters."""
+    if g.protocol.text is not None:
+        pytest.skip("a text protocol's parser has no whole-frame path")
+    name = g.protocol.name
+    one = Driver(name, GENERATED_C / name, tmp_path, defines=(f"-D{name.upper()}_PARSER_WHOLE_FRAMES=0",))
+    directions = list(g.protocol.framing.layouts)
+    try:
+
+        @settings(max_examples=examples(10), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+        @given(st.sampled_from(directions).flatmap(lambda d: st.tuples(st.just(d), noisy_stream(g, d))), st.data())
+        def agree(case: tuple[Direction, bytes], data: st.DataObject) -> None:
+            direction, stream = case
+            sizes = data.draw(st.lists(st.integers(0, 300), min_size=1, max_size=4))
+            if not any(sizes):
+                sizes.append(1)
+            stream_agrees_with_python(one, g, direction, stream, ",".join(map(str, sizes)))
+
+        agree()
+    finally:
+        one.close()
+
+
 LENGTH_BYTE = [g for g in C_SPECS if length_byte.applies(g.protocol)]
 
 
@@ -523,6 +550,55 @@ def test_feature_switches_leave_out_encode_decode_or_parser_without_a_warning(g:
         command = [GCC, *FLAGS, "-Os", *switches, "-c", str(sources(g)[0]), "-o", str(tmp_path / "x.o")]
         run = subprocess.run(command, capture_output=True)
         assert run.returncode == 0 and not run.stderr, run.stderr.decode()
+
+
+ROLES = ("HOST", "DEVICE")
+
+
+@pytest.mark.parametrize("role", ROLES)
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_a_build_for_one_role_keeps_its_side_and_refuses_the_other(g: Generated, role: str, tmp_path: Path) -> None:
+    """P_ROLE=P_ROLE_HOST (sends requests, reads responses) or P_ROLE_DEVICE (the other way): compiled warning-free
+    under the strict flags with each switch; the shipped vector check passes on the side the role reads; every example
+    of that side decodes and parses as in the full build, every example of the side it sends encodes to the example's
+    bytes (from the full build's message), and the other side's frames and messages are refused with E_ARG."""
+    assert GCC is not None
+    name, upper = g.protocol.name, g.protocol.name.upper()
+    role_define = f"-D{upper}_ROLE={upper}_ROLE_{role}"
+    for switches in ([], [f"-D{upper}_ENABLE_ENCODE=0"], [f"-D{upper}_ENABLE_DECODE=0", f"-D{upper}_ENABLE_PARSER=0"]):
+        command = [GCC, *FLAGS, "-O2", role_define, *switches, "-c", str(sources(g)[0]), "-o", str(tmp_path / "x.o")]
+        run = subprocess.run(command, capture_output=True)
+        assert run.returncode == 0 and not run.stderr, run.stderr.decode()
+    folder = GENERATED_C / name
+    check = folder / "test" / "check_vectors.c"
+    if check.exists():
+        exe = tmp_path / "check_vectors"
+        sources_ = [str(check), str(folder / f"{name}.c")]
+        build = [GCC, *FLAGS, *SANITIZE, "-O0", role_define, "-I", str(folder), *sources_, "-o", str(exe)]
+        subprocess.run(build, check=True, capture_output=True)
+        run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0 and run.stdout.endswith(" 0 failed\n"), run.stdout + run.stderr
+    full = driver(name)
+    one = Driver(name, GENERATED_C / name, tmp_path, defines=(role_define,))
+    reads = Direction.RESPONSE if role == "HOST" else Direction.REQUEST
+    try:
+        for example in g.protocol.examples:
+            d, frame = example.direction.value, example.frame.hex()
+            kind = kind_of(g, example_class(g, example))
+            (raw,) = full.ask(f"raw {d} {frame} {kind}")
+            assert raw.startswith("ok ")
+            (encoded,) = one.ask(f"encraw {d} {raw[3:]}")
+            (decoded,) = one.ask(f"dec {d} {frame} {kind}")
+            stream = one.ask(f"stream {d} 1 {frame}")
+            if example.direction == reads:
+                assert decoded == full.ask(f"dec {d} {frame} {kind}")[0]
+                assert stream == full.ask(f"stream {d} 1 {frame}")
+                assert encoded == "err E_ARG"
+            else:
+                assert (decoded, stream) == ("err E_ARG", ["end 0 0 0 0"])
+                assert encoded == f"ok {frame}"
+    finally:
+        one.close()
 
 
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)

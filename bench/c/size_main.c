@@ -35,7 +35,7 @@ int main(void)
 #if PU(ENABLE_PARSER)
     {
         bool got;
-        P(parser_init)(&parser, PU(RESPONSE));
+        P(parser_init)(&parser, PU(DECODES_RESPONSES) ? PU(RESPONSE) : PU(REQUEST)); /* the side the build reads */
         sink = (uint8_t)P(parser_feed)(&parser, frame, sink, &msg, &got);
     }
 #endif

@@ -6,6 +6,8 @@
  *   stream DIR SIZES HEX     feed the bytes in pieces of SIZES (comma-separated, repeated): "msg <json>" per message,
  *                            then "end <frames> <garbage> <errors> <held>"
  *   enc1 DIR HEX CAP         decode, then encode into CAP bytes with canary bytes after them: "ok <hex>" / "err <r>"
+ *   raw DIR HEX [KIND]       decode: "ok <the msg_t's bytes in hex>" or "err <result>" (for encraw in another build)
+ *   encraw DIR HEX           a msg_t from its bytes in hex (raw's, same compiler), encoded: "ok <hex>" / "err <r>"
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,7 +72,29 @@ int main(void)
             continue;
         }
         dir = strcmp(dir_text, "request") == 0 ? CAT(PROTO_UPPER, _REQUEST) : CAT(PROTO_UPPER, _RESPONSE);
-        if (strcmp(cmd, "dec") == 0 || strcmp(cmd, "rt") == 0 || strcmp(cmd, "enc1") == 0) {
+        if (strcmp(cmd, "raw") == 0 || strcmp(cmd, "encraw") == 0) {
+            char *hex = strtok(NULL, " \n");
+            char *extra = strtok(NULL, " \n");
+            size_t n = unhex(hex ? hex : "", frame, sizeof(frame)), len = 0u;
+            int r;
+            if (strcmp(cmd, "raw") == 0) {
+                r = P(decode_expect)(frame, n, dir, kind_of(extra), &msg);
+                if (r == 0) {
+                    memcpy(out, &msg, sizeof(msg));
+                    len = sizeof(msg);
+                }
+            } else {
+                memcpy(&msg, frame, n < sizeof(msg) ? n : sizeof(msg));
+                r = P(encode)(&msg, out, sizeof(out), &len);
+            }
+            if (r != 0) {
+                printf("err %s\n", P(result_name)(r));
+            } else {
+                printf("ok ");
+                puthex(out, len);
+                printf("\n");
+            }
+        } else if (strcmp(cmd, "dec") == 0 || strcmp(cmd, "rt") == 0 || strcmp(cmd, "enc1") == 0) {
             char *hex = strtok(NULL, " \n");
             char *extra = strtok(NULL, " \n");
             size_t n = unhex(hex ? hex : "", frame, sizeof(frame));

@@ -25,6 +25,16 @@ typedef char crsf__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define CRSF__LENGTHS 1 /* every layout has a length element */
 #define CRSF__SINGLE 1 /* one layout per direction */
 #define CRSF__TABLES (CRSF_ENABLE_ENCODE || CRSF__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (CRSF_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define CRSF__DECODES(dir) ((dir) == CRSF_REQUEST ? CRSF_DECODES_REQUESTS : (dir) == CRSF_RESPONSE && CRSF_DECODES_RESPONSES)
+#if CRSF_DECODES_REQUESTS && !CRSF_DECODES_RESPONSES
+#define CRSF__RX(dir) CRSF_REQUEST
+#elif CRSF_DECODES_RESPONSES && !CRSF_DECODES_REQUESTS
+#define CRSF__RX(dir) CRSF_RESPONSE
+#else
+#define CRSF__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* CRC-8/DVB-S2: width 8, poly 0xd5, init 0x0, refin false, refout false, xorout 0x0 (check 0xbc). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -230,7 +240,10 @@ static int crsf__rewrite(const crsf__layout_t *L, int to_wire, const uint8_t *sr
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1562,6 +1575,9 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
         return CRSF_E_ARG;
     }
     out->kind = CRSF_KIND_NONE;
+    if (!CRSF__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return CRSF_E_ARG;
+    }
     count = crsf__count(dir);
     if (count == 0u) {
         return CRSF_E_ARG;
@@ -2049,6 +2065,7 @@ int crsf_encode_gps_request(const crsf_gps_request_t *m, uint8_t *buf, size_t ca
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 2UL, values, m, crsf__enc_gps_request, buf, cap, len);
 }
@@ -2059,6 +2076,7 @@ int crsf_encode_gps_response(const crsf_gps_response_t *m, uint8_t *buf, size_t 
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 2UL, values, m, crsf__enc_gps_response, buf, cap, len);
 }
@@ -2069,6 +2087,7 @@ int crsf_encode_battery_request(const crsf_battery_request_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 8UL, values, m, crsf__enc_battery_request, buf, cap, len);
 }
@@ -2079,6 +2098,7 @@ int crsf_encode_battery_response(const crsf_battery_response_t *m, uint8_t *buf,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 8UL, values, m, crsf__enc_battery_response, buf, cap, len);
 }
@@ -2089,6 +2109,7 @@ int crsf_encode_link_statistics_request(const crsf_link_statistics_request_t *m,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 20UL, values, m, crsf__enc_link_statistics_request, buf, cap, len);
 }
@@ -2099,6 +2120,7 @@ int crsf_encode_link_statistics_response(const crsf_link_statistics_response_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 20UL, values, m, crsf__enc_link_statistics_response, buf, cap, len);
 }
@@ -2109,6 +2131,7 @@ int crsf_encode_rc_channels_request(const crsf_rc_channels_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 22UL, values, m, crsf__enc_rc_channels_request, buf, cap, len);
 }
@@ -2119,6 +2142,7 @@ int crsf_encode_rc_channels_response(const crsf_rc_channels_response_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 22UL, values, m, crsf__enc_rc_channels_response, buf, cap, len);
 }
@@ -2129,6 +2153,7 @@ int crsf_encode_attitude_request(const crsf_attitude_request_t *m, uint8_t *buf,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 30UL, values, m, crsf__enc_attitude_request, buf, cap, len);
 }
@@ -2139,6 +2164,7 @@ int crsf_encode_attitude_response(const crsf_attitude_response_t *m, uint8_t *bu
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 30UL, values, m, crsf__enc_attitude_response, buf, cap, len);
 }
@@ -2149,6 +2175,7 @@ int crsf_encode_flight_mode_request(const crsf_flight_mode_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 33UL, values, m, crsf__enc_flight_mode_request, buf, cap, len);
 }
@@ -2159,6 +2186,7 @@ int crsf_encode_flight_mode_response(const crsf_flight_mode_response_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 33UL, values, m, crsf__enc_flight_mode_response, buf, cap, len);
 }
@@ -2169,6 +2197,7 @@ int crsf_encode_device_ping_request(const crsf_device_ping_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_REQUESTS) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_REQUEST, 40UL, values, m, crsf__enc_device_ping_request, buf, cap, len);
 }
@@ -2179,6 +2208,7 @@ int crsf_encode_device_info_response(const crsf_device_info_response_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return CRSF_E_ARG; }
     *len = 0u;
+    if (!CRSF_ENCODES_RESPONSES) { return CRSF_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return crsf__frame(CRSF_RESPONSE, 41UL, values, m, crsf__enc_device_info_response, buf, cap, len);
 }
@@ -2190,34 +2220,62 @@ int crsf_encode(const crsf_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     }
     *len = 0u;
     switch (msg->kind) {
+#if CRSF_ENCODES_REQUESTS
     case CRSF_GPS_REQUEST:
         return crsf_encode_gps_request(&msg->u.gps_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_GPS_RESPONSE:
         return crsf_encode_gps_response(&msg->u.gps_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_BATTERY_REQUEST:
         return crsf_encode_battery_request(&msg->u.battery_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_BATTERY_RESPONSE:
         return crsf_encode_battery_response(&msg->u.battery_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_LINK_STATISTICS_REQUEST:
         return crsf_encode_link_statistics_request(&msg->u.link_statistics_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_LINK_STATISTICS_RESPONSE:
         return crsf_encode_link_statistics_response(&msg->u.link_statistics_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_RC_CHANNELS_REQUEST:
         return crsf_encode_rc_channels_request(&msg->u.rc_channels_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_RC_CHANNELS_RESPONSE:
         return crsf_encode_rc_channels_response(&msg->u.rc_channels_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_ATTITUDE_REQUEST:
         return crsf_encode_attitude_request(&msg->u.attitude_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_ATTITUDE_RESPONSE:
         return crsf_encode_attitude_response(&msg->u.attitude_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_FLIGHT_MODE_REQUEST:
         return crsf_encode_flight_mode_request(&msg->u.flight_mode_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_FLIGHT_MODE_RESPONSE:
         return crsf_encode_flight_mode_response(&msg->u.flight_mode_response, buf, cap, len);
+#endif
+#if CRSF_ENCODES_REQUESTS
     case CRSF_DEVICE_PING_REQUEST:
         return crsf_encode_device_ping_request(&msg->u.device_ping_request, buf, cap, len);
+#endif
+#if CRSF_ENCODES_RESPONSES
     case CRSF_DEVICE_INFO_RESPONSE:
         return crsf_encode_device_info_response(&msg->u.device_info_response, buf, cap, len);
+#endif
     default:
         return CRSF_E_ARG;
     }
@@ -2242,13 +2300,13 @@ void crsf_parser_init(crsf_parser_t *parser, crsf_direction_t dir)
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size)
 {
-    uint8_t count = crsf__count(p->dir), k;
+    uint8_t count = crsf__count(CRSF__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = crsf__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = crsf__probe_at(CRSF__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == CRSF__WAIT) {
             need = 0u;
             continue;
@@ -2262,7 +2320,7 @@ static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size
             }
             continue;
         }
-        if (crsf_decode(p->buf + pos, (size_t)s, p->dir, out) != CRSF_OK) {
+        if (crsf_decode(p->buf + pos, (size_t)s, CRSF__RX(p->dir), out) != CRSF_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = CRSF__V_CORRUPT;
             }
@@ -2283,7 +2341,7 @@ static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size
 static size_t crsf__next(crsf_parser_t *p, size_t start)
 {
 #if CRSF__HEADERS
-    uint8_t count = crsf__count(p->dir), k;
+    uint8_t count = crsf__count(CRSF__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2292,7 +2350,7 @@ static size_t crsf__next(crsf_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = crsf__header(p->dir, k, &hl);
+            const uint8_t *h = crsf__header(CRSF__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (crsf__same(p->buf + pos, h, hl)) {
@@ -2330,10 +2388,10 @@ static void crsf__drop(crsf_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int crsf__ends_header(const crsf_parser_t *p)
 {
-    uint8_t count = crsf__count(p->dir), k;
+    uint8_t count = crsf__count(CRSF__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = crsf__header(p->dir, k, &hl);
+        const uint8_t *h = crsf__header(CRSF__RX(p->dir), k, &hl);
         if (hl <= p->n && crsf__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2415,7 +2473,7 @@ static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
     return got;
 }
 
-#if CRSF__HEADERS
+#if CRSF__HEADERS && CRSF_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through crsf__push. */
@@ -2424,14 +2482,14 @@ static size_t crsf__whole(crsf_parser_t *p, const uint8_t *data, size_t len, crs
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!CRSF__SINGLE && crsf__count(p->dir) != 1u) {
+    if (!CRSF__SINGLE && crsf__count(CRSF__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = crsf__header(p->dir, 0u, &hl);
+    h = crsf__header(CRSF__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !crsf__same(data, h, hl)) {
         return 0u;
     }
-    s = crsf__probe_at(p->dir, 0u, data, len);
+    s = crsf__probe_at(CRSF__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > CRSF_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2441,7 +2499,7 @@ static size_t crsf__whole(crsf_parser_t *p, const uint8_t *data, size_t len, crs
             return 0u;
         }
     }
-    if (crsf_decode(data, size, p->dir, out) != CRSF_OK) {
+    if (crsf_decode(data, size, CRSF__RX(p->dir), out) != CRSF_OK) {
         return 0u;
     }
     p->frames++;
@@ -2453,8 +2511,13 @@ size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, 
 {
     size_t i;
     *got = false;
+#if CRSF_ROLE != CRSF_ROLE_BOTH
+    if (!CRSF__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if CRSF__HEADERS
+#if CRSF__HEADERS && CRSF_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = crsf__whole(parser, data + i, len - i, out);
             if (size > 0u) {

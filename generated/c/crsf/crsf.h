@@ -28,6 +28,31 @@ extern "C" {
 #define CRSF_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. CRSF_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); CRSF_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * CRSF_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (CRSF_E_ARG). */
+#define CRSF_ROLE_HOST 1
+#define CRSF_ROLE_DEVICE 2
+#define CRSF_ROLE_BOTH 3
+#ifndef CRSF_ROLE
+#define CRSF_ROLE CRSF_ROLE_BOTH
+#endif
+#if CRSF_ROLE != CRSF_ROLE_HOST && CRSF_ROLE != CRSF_ROLE_DEVICE && CRSF_ROLE != CRSF_ROLE_BOTH
+#error "CRSF_ROLE must be CRSF_ROLE_HOST, CRSF_ROLE_DEVICE or CRSF_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define CRSF_ENCODES_REQUESTS (CRSF_ENABLE_ENCODE && CRSF_ROLE != CRSF_ROLE_DEVICE)
+#define CRSF_ENCODES_RESPONSES (CRSF_ENABLE_ENCODE && CRSF_ROLE != CRSF_ROLE_HOST)
+#define CRSF_DECODES_REQUESTS (CRSF_ENABLE_DECODE && CRSF_ROLE != CRSF_ROLE_HOST)
+#define CRSF_DECODES_RESPONSES (CRSF_ENABLE_DECODE && CRSF_ROLE != CRSF_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef CRSF_PARSER_WHOLE_FRAMES
+#define CRSF_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 257 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef CRSF_MAX_FRAME

@@ -25,6 +25,16 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
 #define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
 #define DYNAMIXEL_P2__TABLES (DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (DYNAMIXEL_P2_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define DYNAMIXEL_P2__DECODES(dir) ((dir) == DYNAMIXEL_P2_REQUEST ? DYNAMIXEL_P2_DECODES_REQUESTS : (dir) == DYNAMIXEL_P2_RESPONSE && DYNAMIXEL_P2_DECODES_RESPONSES)
+#if DYNAMIXEL_P2_DECODES_REQUESTS && !DYNAMIXEL_P2_DECODES_RESPONSES
+#define DYNAMIXEL_P2__RX(dir) DYNAMIXEL_P2_REQUEST
+#elif DYNAMIXEL_P2_DECODES_RESPONSES && !DYNAMIXEL_P2_DECODES_REQUESTS
+#define DYNAMIXEL_P2__RX(dir) DYNAMIXEL_P2_RESPONSE
+#else
+#define DYNAMIXEL_P2__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -230,7 +240,10 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1275,6 +1288,9 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
         return DYNAMIXEL_P2_E_ARG;
     }
     out->kind = DYNAMIXEL_P2_KIND_NONE;
+    if (!DYNAMIXEL_P2__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return DYNAMIXEL_P2_E_ARG;
+    }
     count = dynamixel_p2__count(dir);
     if (count == 0u) {
         return DYNAMIXEL_P2_E_ARG;
@@ -1703,6 +1719,7 @@ int dynamixel_p2_encode_ping_request(const dynamixel_p2_ping_request_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 1UL, values, m, dynamixel_p2__enc_ping_request, buf, cap, len);
@@ -1714,6 +1731,7 @@ int dynamixel_p2_encode_ping_response(const dynamixel_p2_ping_response_t *m, uin
     uint32_t values[2];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_RESPONSES) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     values[1] = (uint32_t)m->error;
@@ -1726,6 +1744,7 @@ int dynamixel_p2_encode_read_request(const dynamixel_p2_read_request_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 2UL, values, m, dynamixel_p2__enc_read_request, buf, cap, len);
@@ -1737,6 +1756,7 @@ int dynamixel_p2_encode_write_request(const dynamixel_p2_write_request_t *m, uin
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 3UL, values, m, dynamixel_p2__enc_write_request, buf, cap, len);
@@ -1748,6 +1768,7 @@ int dynamixel_p2_encode_reg_write_request(const dynamixel_p2_reg_write_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 4UL, values, m, dynamixel_p2__enc_reg_write_request, buf, cap, len);
@@ -1759,6 +1780,7 @@ int dynamixel_p2_encode_action_request(const dynamixel_p2_action_request_t *m, u
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 5UL, values, m, dynamixel_p2__enc_action_request, buf, cap, len);
@@ -1770,6 +1792,7 @@ int dynamixel_p2_encode_factory_reset_request(const dynamixel_p2_factory_reset_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 6UL, values, m, dynamixel_p2__enc_factory_reset_request, buf, cap, len);
@@ -1781,6 +1804,7 @@ int dynamixel_p2_encode_reboot_request(const dynamixel_p2_reboot_request_t *m, u
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 8UL, values, m, dynamixel_p2__enc_reboot_request, buf, cap, len);
@@ -1792,6 +1816,7 @@ int dynamixel_p2_encode_clear_request(const dynamixel_p2_clear_request_t *m, uin
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 16UL, values, m, dynamixel_p2__enc_clear_request, buf, cap, len);
@@ -1803,6 +1828,7 @@ int dynamixel_p2_encode_sync_read_request(const dynamixel_p2_sync_read_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 130UL, values, m, dynamixel_p2__enc_sync_read_request, buf, cap, len);
@@ -1814,6 +1840,7 @@ int dynamixel_p2_encode_fast_sync_read_request(const dynamixel_p2_fast_sync_read
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 138UL, values, m, dynamixel_p2__enc_fast_sync_read_request, buf, cap, len);
@@ -1825,6 +1852,7 @@ int dynamixel_p2_encode_sync_write_request(const dynamixel_p2_sync_write_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 131UL, values, m, dynamixel_p2__enc_sync_write_request, buf, cap, len);
@@ -1836,6 +1864,7 @@ int dynamixel_p2_encode_bulk_read_request(const dynamixel_p2_bulk_read_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 146UL, values, m, dynamixel_p2__enc_bulk_read_request, buf, cap, len);
@@ -1847,6 +1876,7 @@ int dynamixel_p2_encode_bulk_write_request(const dynamixel_p2_bulk_write_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_REQUESTS) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return dynamixel_p2__frame(DYNAMIXEL_P2_REQUEST, 147UL, values, m, dynamixel_p2__enc_bulk_write_request, buf, cap, len);
@@ -1858,6 +1888,7 @@ int dynamixel_p2_encode_status_response(const dynamixel_p2_status_response_t *m,
     uint32_t values[2];
     if (m == NULL || buf == NULL || len == NULL) { return DYNAMIXEL_P2_E_ARG; }
     *len = 0u;
+    if (!DYNAMIXEL_P2_ENCODES_RESPONSES) { return DYNAMIXEL_P2_E_ARG; } /* left out of this build */
     if ((m->id > 252u) && m->id != 254u) { return DYNAMIXEL_P2_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     values[1] = (uint32_t)m->error;
@@ -1871,36 +1902,66 @@ int dynamixel_p2_encode(const dynamixel_p2_msg_t *msg, uint8_t *buf, size_t cap,
     }
     *len = 0u;
     switch (msg->kind) {
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_PING_REQUEST:
         return dynamixel_p2_encode_ping_request(&msg->u.ping_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_RESPONSES
     case DYNAMIXEL_P2_PING_RESPONSE:
         return dynamixel_p2_encode_ping_response(&msg->u.ping_response, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_READ_REQUEST:
         return dynamixel_p2_encode_read_request(&msg->u.read_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_WRITE_REQUEST:
         return dynamixel_p2_encode_write_request(&msg->u.write_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_REG_WRITE_REQUEST:
         return dynamixel_p2_encode_reg_write_request(&msg->u.reg_write_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_ACTION_REQUEST:
         return dynamixel_p2_encode_action_request(&msg->u.action_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_FACTORY_RESET_REQUEST:
         return dynamixel_p2_encode_factory_reset_request(&msg->u.factory_reset_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_REBOOT_REQUEST:
         return dynamixel_p2_encode_reboot_request(&msg->u.reboot_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_CLEAR_REQUEST:
         return dynamixel_p2_encode_clear_request(&msg->u.clear_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_SYNC_READ_REQUEST:
         return dynamixel_p2_encode_sync_read_request(&msg->u.sync_read_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_FAST_SYNC_READ_REQUEST:
         return dynamixel_p2_encode_fast_sync_read_request(&msg->u.fast_sync_read_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_SYNC_WRITE_REQUEST:
         return dynamixel_p2_encode_sync_write_request(&msg->u.sync_write_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_BULK_READ_REQUEST:
         return dynamixel_p2_encode_bulk_read_request(&msg->u.bulk_read_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_REQUESTS
     case DYNAMIXEL_P2_BULK_WRITE_REQUEST:
         return dynamixel_p2_encode_bulk_write_request(&msg->u.bulk_write_request, buf, cap, len);
+#endif
+#if DYNAMIXEL_P2_ENCODES_RESPONSES
     case DYNAMIXEL_P2_STATUS_RESPONSE:
         return dynamixel_p2_encode_status_response(&msg->u.status_response, buf, cap, len);
+#endif
     default:
         return DYNAMIXEL_P2_E_ARG;
     }
@@ -1925,13 +1986,13 @@ void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direct
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_msg_t *out, size_t *size)
 {
-    uint8_t count = dynamixel_p2__count(p->dir), k;
+    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = dynamixel_p2__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = dynamixel_p2__probe_at(DYNAMIXEL_P2__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == DYNAMIXEL_P2__WAIT) {
             need = 0u;
             continue;
@@ -1945,7 +2006,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
             }
             continue;
         }
-        if (dynamixel_p2_decode(p->buf + pos, (size_t)s, p->dir, out) != DYNAMIXEL_P2_OK) {
+        if (dynamixel_p2_decode(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), out) != DYNAMIXEL_P2_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = DYNAMIXEL_P2__V_CORRUPT;
             }
@@ -1966,7 +2027,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
 static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
 {
 #if DYNAMIXEL_P2__HEADERS
-    uint8_t count = dynamixel_p2__count(p->dir), k;
+    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -1975,7 +2036,7 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = dynamixel_p2__header(p->dir, k, &hl);
+            const uint8_t *h = dynamixel_p2__header(DYNAMIXEL_P2__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (dynamixel_p2__same(p->buf + pos, h, hl)) {
@@ -2013,10 +2074,10 @@ static void dynamixel_p2__drop(dynamixel_p2_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int dynamixel_p2__ends_header(const dynamixel_p2_parser_t *p)
 {
-    uint8_t count = dynamixel_p2__count(p->dir), k;
+    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = dynamixel_p2__header(p->dir, k, &hl);
+        const uint8_t *h = dynamixel_p2__header(DYNAMIXEL_P2__RX(p->dir), k, &hl);
         if (hl <= p->n && dynamixel_p2__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2098,7 +2159,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     return got;
 }
 
-#if DYNAMIXEL_P2__HEADERS
+#if DYNAMIXEL_P2__HEADERS && DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through dynamixel_p2__push. */
@@ -2107,14 +2168,14 @@ static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data,
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!DYNAMIXEL_P2__SINGLE && dynamixel_p2__count(p->dir) != 1u) {
+    if (!DYNAMIXEL_P2__SINGLE && dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = dynamixel_p2__header(p->dir, 0u, &hl);
+    h = dynamixel_p2__header(DYNAMIXEL_P2__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !dynamixel_p2__same(data, h, hl)) {
         return 0u;
     }
-    s = dynamixel_p2__probe_at(p->dir, 0u, data, len);
+    s = dynamixel_p2__probe_at(DYNAMIXEL_P2__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2124,7 +2185,7 @@ static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (dynamixel_p2_decode(data, size, p->dir, out) != DYNAMIXEL_P2_OK) {
+    if (dynamixel_p2_decode(data, size, DYNAMIXEL_P2__RX(p->dir), out) != DYNAMIXEL_P2_OK) {
         return 0u;
     }
     p->frames++;
@@ -2136,8 +2197,13 @@ size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *da
 {
     size_t i;
     *got = false;
+#if DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_BOTH
+    if (!DYNAMIXEL_P2__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if DYNAMIXEL_P2__HEADERS
+#if DYNAMIXEL_P2__HEADERS && DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = dynamixel_p2__whole(parser, data + i, len - i, out);
             if (size > 0u) {

@@ -28,6 +28,31 @@ extern "C" {
 #define DYNAMIXEL_P2_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. DYNAMIXEL_P2_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); DYNAMIXEL_P2_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * DYNAMIXEL_P2_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (DYNAMIXEL_P2_E_ARG). */
+#define DYNAMIXEL_P2_ROLE_HOST 1
+#define DYNAMIXEL_P2_ROLE_DEVICE 2
+#define DYNAMIXEL_P2_ROLE_BOTH 3
+#ifndef DYNAMIXEL_P2_ROLE
+#define DYNAMIXEL_P2_ROLE DYNAMIXEL_P2_ROLE_BOTH
+#endif
+#if DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_HOST && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_DEVICE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_BOTH
+#error "DYNAMIXEL_P2_ROLE must be DYNAMIXEL_P2_ROLE_HOST, DYNAMIXEL_P2_ROLE_DEVICE or DYNAMIXEL_P2_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define DYNAMIXEL_P2_ENCODES_REQUESTS (DYNAMIXEL_P2_ENABLE_ENCODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_DEVICE)
+#define DYNAMIXEL_P2_ENCODES_RESPONSES (DYNAMIXEL_P2_ENABLE_ENCODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_HOST)
+#define DYNAMIXEL_P2_DECODES_REQUESTS (DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_HOST)
+#define DYNAMIXEL_P2_DECODES_RESPONSES (DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
+#define DYNAMIXEL_P2_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65542 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef DYNAMIXEL_P2_MAX_FRAME

@@ -25,6 +25,16 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
 #define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
 #define FASHIONSTAR_UART__TABLES (FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (FASHIONSTAR_UART_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define FASHIONSTAR_UART__DECODES(dir) ((dir) == FASHIONSTAR_UART_REQUEST ? FASHIONSTAR_UART_DECODES_REQUESTS : (dir) == FASHIONSTAR_UART_RESPONSE && FASHIONSTAR_UART_DECODES_RESPONSES)
+#if FASHIONSTAR_UART_DECODES_REQUESTS && !FASHIONSTAR_UART_DECODES_RESPONSES
+#define FASHIONSTAR_UART__RX(dir) FASHIONSTAR_UART_REQUEST
+#elif FASHIONSTAR_UART_DECODES_RESPONSES && !FASHIONSTAR_UART_DECODES_REQUESTS
+#define FASHIONSTAR_UART__RX(dir) FASHIONSTAR_UART_RESPONSE
+#else
+#define FASHIONSTAR_UART__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
@@ -226,7 +236,10 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2380,6 +2393,9 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
         return FASHIONSTAR_UART_E_ARG;
     }
     out->kind = FASHIONSTAR_UART_KIND_NONE;
+    if (!FASHIONSTAR_UART__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return FASHIONSTAR_UART_E_ARG;
+    }
     count = fashionstar_uart__count(dir);
     if (count == 0u) {
         return FASHIONSTAR_UART_E_ARG;
@@ -3813,6 +3829,7 @@ int fashionstar_uart_encode_ping_request(const fashionstar_uart_ping_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 1UL, values, m, fashionstar_uart__enc_ping_request, buf, cap, len);
 }
@@ -3823,6 +3840,7 @@ int fashionstar_uart_encode_ping_response(const fashionstar_uart_ping_response_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 1UL, values, m, fashionstar_uart__enc_ping_response, buf, cap, len);
 }
@@ -3833,6 +3851,7 @@ int fashionstar_uart_encode_reset_user_data_request(const fashionstar_uart_reset
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 2UL, values, m, fashionstar_uart__enc_reset_user_data_request, buf, cap, len);
 }
@@ -3843,6 +3862,7 @@ int fashionstar_uart_encode_reset_user_data_response(const fashionstar_uart_rese
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 2UL, values, m, fashionstar_uart__enc_reset_user_data_response, buf, cap, len);
 }
@@ -3853,6 +3873,7 @@ int fashionstar_uart_encode_read_data_request(const fashionstar_uart_read_data_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 3UL, values, m, fashionstar_uart__enc_read_data_request, buf, cap, len);
 }
@@ -3863,6 +3884,7 @@ int fashionstar_uart_encode_read_data_response(const fashionstar_uart_read_data_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 3UL, values, m, fashionstar_uart__enc_read_data_response, buf, cap, len);
 }
@@ -3873,6 +3895,7 @@ int fashionstar_uart_encode_write_data_request(const fashionstar_uart_write_data
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 4UL, values, m, fashionstar_uart__enc_write_data_request, buf, cap, len);
 }
@@ -3883,6 +3906,7 @@ int fashionstar_uart_encode_write_data_response(const fashionstar_uart_write_dat
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 4UL, values, m, fashionstar_uart__enc_write_data_response, buf, cap, len);
 }
@@ -3893,6 +3917,7 @@ int fashionstar_uart_encode_read_batch_data_request(const fashionstar_uart_read_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 5UL, values, m, fashionstar_uart__enc_read_batch_data_request, buf, cap, len);
 }
@@ -3903,6 +3928,7 @@ int fashionstar_uart_encode_read_batch_data_response(const fashionstar_uart_read
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 5UL, values, m, fashionstar_uart__enc_read_batch_data_response, buf, cap, len);
 }
@@ -3913,6 +3939,7 @@ int fashionstar_uart_encode_write_batch_data_request(const fashionstar_uart_writ
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 6UL, values, m, fashionstar_uart__enc_write_batch_data_request, buf, cap, len);
 }
@@ -3923,6 +3950,7 @@ int fashionstar_uart_encode_write_batch_data_response(const fashionstar_uart_wri
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 6UL, values, m, fashionstar_uart__enc_write_batch_data_response, buf, cap, len);
 }
@@ -3933,6 +3961,7 @@ int fashionstar_uart_encode_spin_request(const fashionstar_uart_spin_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 7UL, values, m, fashionstar_uart__enc_spin_request, buf, cap, len);
 }
@@ -3943,6 +3972,7 @@ int fashionstar_uart_encode_spin_response(const fashionstar_uart_spin_response_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 7UL, values, m, fashionstar_uart__enc_spin_response, buf, cap, len);
 }
@@ -3953,6 +3983,7 @@ int fashionstar_uart_encode_rotate_request(const fashionstar_uart_rotate_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 8UL, values, m, fashionstar_uart__enc_rotate_request, buf, cap, len);
 }
@@ -3963,6 +3994,7 @@ int fashionstar_uart_encode_rotate_response(const fashionstar_uart_rotate_respon
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 8UL, values, m, fashionstar_uart__enc_rotate_response, buf, cap, len);
 }
@@ -3973,6 +4005,7 @@ int fashionstar_uart_encode_damping_request(const fashionstar_uart_damping_reque
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 9UL, values, m, fashionstar_uart__enc_damping_request, buf, cap, len);
 }
@@ -3983,6 +4016,7 @@ int fashionstar_uart_encode_damping_response(const fashionstar_uart_damping_resp
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 9UL, values, m, fashionstar_uart__enc_damping_response, buf, cap, len);
 }
@@ -3993,6 +4027,7 @@ int fashionstar_uart_encode_read_angle_request(const fashionstar_uart_read_angle
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 10UL, values, m, fashionstar_uart__enc_read_angle_request, buf, cap, len);
 }
@@ -4003,6 +4038,7 @@ int fashionstar_uart_encode_read_angle_response(const fashionstar_uart_read_angl
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 10UL, values, m, fashionstar_uart__enc_read_angle_response, buf, cap, len);
 }
@@ -4013,6 +4049,7 @@ int fashionstar_uart_encode_move_by_interval_request(const fashionstar_uart_move
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 11UL, values, m, fashionstar_uart__enc_move_by_interval_request, buf, cap, len);
 }
@@ -4023,6 +4060,7 @@ int fashionstar_uart_encode_move_by_interval_response(const fashionstar_uart_mov
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 11UL, values, m, fashionstar_uart__enc_move_by_interval_response, buf, cap, len);
 }
@@ -4033,6 +4071,7 @@ int fashionstar_uart_encode_move_by_velocity_request(const fashionstar_uart_move
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 12UL, values, m, fashionstar_uart__enc_move_by_velocity_request, buf, cap, len);
 }
@@ -4043,6 +4082,7 @@ int fashionstar_uart_encode_move_by_velocity_response(const fashionstar_uart_mov
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 12UL, values, m, fashionstar_uart__enc_move_by_velocity_response, buf, cap, len);
 }
@@ -4053,6 +4093,7 @@ int fashionstar_uart_encode_move_mturn_request(const fashionstar_uart_move_mturn
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 13UL, values, m, fashionstar_uart__enc_move_mturn_request, buf, cap, len);
 }
@@ -4063,6 +4104,7 @@ int fashionstar_uart_encode_move_mturn_response(const fashionstar_uart_move_mtur
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 13UL, values, m, fashionstar_uart__enc_move_mturn_response, buf, cap, len);
 }
@@ -4073,6 +4115,7 @@ int fashionstar_uart_encode_move_mturn_by_interval_request(const fashionstar_uar
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 14UL, values, m, fashionstar_uart__enc_move_mturn_by_interval_request, buf, cap, len);
 }
@@ -4083,6 +4126,7 @@ int fashionstar_uart_encode_move_mturn_by_interval_response(const fashionstar_ua
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 14UL, values, m, fashionstar_uart__enc_move_mturn_by_interval_response, buf, cap, len);
 }
@@ -4093,6 +4137,7 @@ int fashionstar_uart_encode_move_mturn_by_velocity_request(const fashionstar_uar
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 15UL, values, m, fashionstar_uart__enc_move_mturn_by_velocity_request, buf, cap, len);
 }
@@ -4103,6 +4148,7 @@ int fashionstar_uart_encode_move_mturn_by_velocity_response(const fashionstar_ua
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 15UL, values, m, fashionstar_uart__enc_move_mturn_by_velocity_response, buf, cap, len);
 }
@@ -4113,6 +4159,7 @@ int fashionstar_uart_encode_read_mturn_angle_request(const fashionstar_uart_read
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 16UL, values, m, fashionstar_uart__enc_read_mturn_angle_request, buf, cap, len);
 }
@@ -4123,6 +4170,7 @@ int fashionstar_uart_encode_read_mturn_angle_response(const fashionstar_uart_rea
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 16UL, values, m, fashionstar_uart__enc_read_mturn_angle_response, buf, cap, len);
 }
@@ -4133,6 +4181,7 @@ int fashionstar_uart_encode_reset_mturn_angle_request(const fashionstar_uart_res
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 17UL, values, m, fashionstar_uart__enc_reset_mturn_angle_request, buf, cap, len);
 }
@@ -4143,6 +4192,7 @@ int fashionstar_uart_encode_begin_async_request(const fashionstar_uart_begin_asy
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 18UL, values, m, fashionstar_uart__enc_begin_async_request, buf, cap, len);
 }
@@ -4153,6 +4203,7 @@ int fashionstar_uart_encode_end_async_request(const fashionstar_uart_end_async_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 19UL, values, m, fashionstar_uart__enc_end_async_request, buf, cap, len);
 }
@@ -4163,6 +4214,7 @@ int fashionstar_uart_encode_monitor_request(const fashionstar_uart_monitor_reque
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 22UL, values, m, fashionstar_uart__enc_monitor_request, buf, cap, len);
 }
@@ -4173,6 +4225,7 @@ int fashionstar_uart_encode_monitor_response(const fashionstar_uart_monitor_resp
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_RESPONSES) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_RESPONSE, 22UL, values, m, fashionstar_uart__enc_monitor_response, buf, cap, len);
 }
@@ -4183,6 +4236,7 @@ int fashionstar_uart_encode_set_origin_point_request(const fashionstar_uart_set_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 23UL, values, m, fashionstar_uart__enc_set_origin_point_request, buf, cap, len);
 }
@@ -4193,6 +4247,7 @@ int fashionstar_uart_encode_stop_on_control_mode_request(const fashionstar_uart_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 24UL, values, m, fashionstar_uart__enc_stop_on_control_mode_request, buf, cap, len);
 }
@@ -4203,6 +4258,7 @@ int fashionstar_uart_encode_sync_command_request(const fashionstar_uart_sync_com
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FASHIONSTAR_UART_E_ARG; }
     *len = 0u;
+    if (!FASHIONSTAR_UART_ENCODES_REQUESTS) { return FASHIONSTAR_UART_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return fashionstar_uart__frame(FASHIONSTAR_UART_REQUEST, 25UL, values, m, fashionstar_uart__enc_sync_command_request, buf, cap, len);
 }
@@ -4214,86 +4270,166 @@ int fashionstar_uart_encode(const fashionstar_uart_msg_t *msg, uint8_t *buf, siz
     }
     *len = 0u;
     switch (msg->kind) {
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_PING_REQUEST:
         return fashionstar_uart_encode_ping_request(&msg->u.ping_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_PING_RESPONSE:
         return fashionstar_uart_encode_ping_response(&msg->u.ping_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_RESET_USER_DATA_REQUEST:
         return fashionstar_uart_encode_reset_user_data_request(&msg->u.reset_user_data_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_RESET_USER_DATA_RESPONSE:
         return fashionstar_uart_encode_reset_user_data_response(&msg->u.reset_user_data_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_READ_DATA_REQUEST:
         return fashionstar_uart_encode_read_data_request(&msg->u.read_data_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_READ_DATA_RESPONSE:
         return fashionstar_uart_encode_read_data_response(&msg->u.read_data_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_WRITE_DATA_REQUEST:
         return fashionstar_uart_encode_write_data_request(&msg->u.write_data_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_WRITE_DATA_RESPONSE:
         return fashionstar_uart_encode_write_data_response(&msg->u.write_data_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_READ_BATCH_DATA_REQUEST:
         return fashionstar_uart_encode_read_batch_data_request(&msg->u.read_batch_data_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_READ_BATCH_DATA_RESPONSE:
         return fashionstar_uart_encode_read_batch_data_response(&msg->u.read_batch_data_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_WRITE_BATCH_DATA_REQUEST:
         return fashionstar_uart_encode_write_batch_data_request(&msg->u.write_batch_data_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_WRITE_BATCH_DATA_RESPONSE:
         return fashionstar_uart_encode_write_batch_data_response(&msg->u.write_batch_data_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_SPIN_REQUEST:
         return fashionstar_uart_encode_spin_request(&msg->u.spin_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_SPIN_RESPONSE:
         return fashionstar_uart_encode_spin_response(&msg->u.spin_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_ROTATE_REQUEST:
         return fashionstar_uart_encode_rotate_request(&msg->u.rotate_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_ROTATE_RESPONSE:
         return fashionstar_uart_encode_rotate_response(&msg->u.rotate_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_DAMPING_REQUEST:
         return fashionstar_uart_encode_damping_request(&msg->u.damping_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_DAMPING_RESPONSE:
         return fashionstar_uart_encode_damping_response(&msg->u.damping_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_READ_ANGLE_REQUEST:
         return fashionstar_uart_encode_read_angle_request(&msg->u.read_angle_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_READ_ANGLE_RESPONSE:
         return fashionstar_uart_encode_read_angle_response(&msg->u.read_angle_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MOVE_BY_INTERVAL_REQUEST:
         return fashionstar_uart_encode_move_by_interval_request(&msg->u.move_by_interval_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MOVE_BY_INTERVAL_RESPONSE:
         return fashionstar_uart_encode_move_by_interval_response(&msg->u.move_by_interval_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MOVE_BY_VELOCITY_REQUEST:
         return fashionstar_uart_encode_move_by_velocity_request(&msg->u.move_by_velocity_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MOVE_BY_VELOCITY_RESPONSE:
         return fashionstar_uart_encode_move_by_velocity_response(&msg->u.move_by_velocity_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MOVE_MTURN_REQUEST:
         return fashionstar_uart_encode_move_mturn_request(&msg->u.move_mturn_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MOVE_MTURN_RESPONSE:
         return fashionstar_uart_encode_move_mturn_response(&msg->u.move_mturn_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MOVE_MTURN_BY_INTERVAL_REQUEST:
         return fashionstar_uart_encode_move_mturn_by_interval_request(&msg->u.move_mturn_by_interval_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MOVE_MTURN_BY_INTERVAL_RESPONSE:
         return fashionstar_uart_encode_move_mturn_by_interval_response(&msg->u.move_mturn_by_interval_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MOVE_MTURN_BY_VELOCITY_REQUEST:
         return fashionstar_uart_encode_move_mturn_by_velocity_request(&msg->u.move_mturn_by_velocity_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MOVE_MTURN_BY_VELOCITY_RESPONSE:
         return fashionstar_uart_encode_move_mturn_by_velocity_response(&msg->u.move_mturn_by_velocity_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_READ_MTURN_ANGLE_REQUEST:
         return fashionstar_uart_encode_read_mturn_angle_request(&msg->u.read_mturn_angle_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_READ_MTURN_ANGLE_RESPONSE:
         return fashionstar_uart_encode_read_mturn_angle_response(&msg->u.read_mturn_angle_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_RESET_MTURN_ANGLE_REQUEST:
         return fashionstar_uart_encode_reset_mturn_angle_request(&msg->u.reset_mturn_angle_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_BEGIN_ASYNC_REQUEST:
         return fashionstar_uart_encode_begin_async_request(&msg->u.begin_async_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_END_ASYNC_REQUEST:
         return fashionstar_uart_encode_end_async_request(&msg->u.end_async_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_MONITOR_REQUEST:
         return fashionstar_uart_encode_monitor_request(&msg->u.monitor_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_RESPONSES
     case FASHIONSTAR_UART_MONITOR_RESPONSE:
         return fashionstar_uart_encode_monitor_response(&msg->u.monitor_response, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_SET_ORIGIN_POINT_REQUEST:
         return fashionstar_uart_encode_set_origin_point_request(&msg->u.set_origin_point_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_STOP_ON_CONTROL_MODE_REQUEST:
         return fashionstar_uart_encode_stop_on_control_mode_request(&msg->u.stop_on_control_mode_request, buf, cap, len);
+#endif
+#if FASHIONSTAR_UART_ENCODES_REQUESTS
     case FASHIONSTAR_UART_SYNC_COMMAND_REQUEST:
         return fashionstar_uart_encode_sync_command_request(&msg->u.sync_command_request, buf, cap, len);
+#endif
     default:
         return FASHIONSTAR_UART_E_ARG;
     }
@@ -4379,9 +4515,9 @@ static int fashionstar_uart__scan(fashionstar_uart_parser_t *p, fashionstar_uart
             continue;
         }
         if (v[pos] == FASHIONSTAR_UART__C_SIZED) {
-            size = fashionstar_uart__size(p->dir, p->buf + pos);
+            size = fashionstar_uart__size(FASHIONSTAR_UART__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (fashionstar_uart_decode(p->buf + pos, size, p->dir, out) == FASHIONSTAR_UART_OK) {
+                if (fashionstar_uart_decode(p->buf + pos, size, FASHIONSTAR_UART__RX(p->dir), out) == FASHIONSTAR_UART_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -4463,12 +4599,12 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     end++;
     n++;
     p->n = n; /* the fields in locals: a store through b or v may change any byte of *p, as far as C knows */
-    if (n >= 2u && fashionstar_uart__same(b + end - 2u, (p->dir == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0), 2u)) { /* a header ends with this byte */
+    if (n >= 2u && fashionstar_uart__same(b + end - 2u, (FASHIONSTAR_UART__RX(p->dir) == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0), 2u)) { /* a header ends with this byte */
         v[end - 2u] = FASHIONSTAR_UART__C_NEW;
     }
     if (n >= need && v[end - need] == FASHIONSTAR_UART__C_NEW) {
         at = end - need;
-        size = fashionstar_uart__size(p->dir, b + at);
+        size = fashionstar_uart__size(FASHIONSTAR_UART__RX(p->dir), b + at);
         if (size == 0u) {
             v[at] = 0u;
         } else {
@@ -4493,17 +4629,18 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     return 0;
 }
 
+#if FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
 {
     const size_t hl = 2u;
-    const uint8_t *h = (p->dir == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0);
+    const uint8_t *h = (FASHIONSTAR_UART__RX(p->dir) == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0);
     size_t i, size;
     if (len < 4u || !fashionstar_uart__same(data, h, hl)) {
         return 0u;
     }
-    size = fashionstar_uart__size(p->dir, data);
+    size = fashionstar_uart__size(FASHIONSTAR_UART__RX(p->dir), data);
     if (size == 0u || size > len) {
         return 0u;
     }
@@ -4512,18 +4649,25 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
             return 0u;
         }
     }
-    if (fashionstar_uart_decode(data, size, p->dir, out) != FASHIONSTAR_UART_OK) {
+    if (fashionstar_uart_decode(data, size, FASHIONSTAR_UART__RX(p->dir), out) != FASHIONSTAR_UART_OK) {
         return 0u;
     }
     p->frames++;
     return size;
 }
+#endif
 
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
+#if FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_BOTH
+    if (!FASHIONSTAR_UART__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
+#if FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = fashionstar_uart__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4531,6 +4675,7 @@ size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uin
                 return i + size;
             }
         }
+#endif
         if (fashionstar_uart__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

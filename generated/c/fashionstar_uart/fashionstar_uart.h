@@ -28,6 +28,31 @@ extern "C" {
 #define FASHIONSTAR_UART_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. FASHIONSTAR_UART_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); FASHIONSTAR_UART_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * FASHIONSTAR_UART_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (FASHIONSTAR_UART_E_ARG). */
+#define FASHIONSTAR_UART_ROLE_HOST 1
+#define FASHIONSTAR_UART_ROLE_DEVICE 2
+#define FASHIONSTAR_UART_ROLE_BOTH 3
+#ifndef FASHIONSTAR_UART_ROLE
+#define FASHIONSTAR_UART_ROLE FASHIONSTAR_UART_ROLE_BOTH
+#endif
+#if FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_HOST && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_DEVICE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_BOTH
+#error "FASHIONSTAR_UART_ROLE must be FASHIONSTAR_UART_ROLE_HOST, FASHIONSTAR_UART_ROLE_DEVICE or FASHIONSTAR_UART_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define FASHIONSTAR_UART_ENCODES_REQUESTS (FASHIONSTAR_UART_ENABLE_ENCODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_DEVICE)
+#define FASHIONSTAR_UART_ENCODES_RESPONSES (FASHIONSTAR_UART_ENABLE_ENCODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_HOST)
+#define FASHIONSTAR_UART_DECODES_REQUESTS (FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_HOST)
+#define FASHIONSTAR_UART_DECODES_RESPONSES (FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
+#define FASHIONSTAR_UART_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 260 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef FASHIONSTAR_UART_MAX_FRAME

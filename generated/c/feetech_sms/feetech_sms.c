@@ -25,6 +25,16 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
 #define FEETECH_SMS__SINGLE 1 /* one layout per direction */
 #define FEETECH_SMS__TABLES (FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (FEETECH_SMS_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define FEETECH_SMS__DECODES(dir) ((dir) == FEETECH_SMS_REQUEST ? FEETECH_SMS_DECODES_REQUESTS : (dir) == FEETECH_SMS_RESPONSE && FEETECH_SMS_DECODES_RESPONSES)
+#if FEETECH_SMS_DECODES_REQUESTS && !FEETECH_SMS_DECODES_RESPONSES
+#define FEETECH_SMS__RX(dir) FEETECH_SMS_REQUEST
+#elif FEETECH_SMS_DECODES_RESPONSES && !FEETECH_SMS_DECODES_REQUESTS
+#define FEETECH_SMS__RX(dir) FEETECH_SMS_RESPONSE
+#else
+#define FEETECH_SMS__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum inverted. */
@@ -226,7 +236,10 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1103,6 +1116,9 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
         return FEETECH_SMS_E_ARG;
     }
     out->kind = FEETECH_SMS_KIND_NONE;
+    if (!FEETECH_SMS__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return FEETECH_SMS_E_ARG;
+    }
     count = feetech_sms__count(dir);
     if (count == 0u) {
         return FEETECH_SMS_E_ARG;
@@ -1379,6 +1395,7 @@ int feetech_sms_encode_ping_request(const feetech_sms_ping_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 1UL, values, m, feetech_sms__enc_ping_request, buf, cap, len);
@@ -1390,6 +1407,7 @@ int feetech_sms_encode_read_request(const feetech_sms_read_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 2UL, values, m, feetech_sms__enc_read_request, buf, cap, len);
@@ -1401,6 +1419,7 @@ int feetech_sms_encode_write_request(const feetech_sms_write_request_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 3UL, values, m, feetech_sms__enc_write_request, buf, cap, len);
@@ -1412,6 +1431,7 @@ int feetech_sms_encode_reg_write_request(const feetech_sms_reg_write_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 4UL, values, m, feetech_sms__enc_reg_write_request, buf, cap, len);
@@ -1423,6 +1443,7 @@ int feetech_sms_encode_action_request(const feetech_sms_action_request_t *m, uin
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 5UL, values, m, feetech_sms__enc_action_request, buf, cap, len);
@@ -1434,6 +1455,7 @@ int feetech_sms_encode_reset_request(const feetech_sms_reset_request_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 6UL, values, m, feetech_sms__enc_reset_request, buf, cap, len);
@@ -1445,6 +1467,7 @@ int feetech_sms_encode_sync_read_request(const feetech_sms_sync_read_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 130UL, values, m, feetech_sms__enc_sync_read_request, buf, cap, len);
@@ -1456,6 +1479,7 @@ int feetech_sms_encode_sync_write_request(const feetech_sms_sync_write_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_REQUESTS) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     return feetech_sms__frame(FEETECH_SMS_REQUEST, 131UL, values, m, feetech_sms__enc_sync_write_request, buf, cap, len);
@@ -1467,6 +1491,7 @@ int feetech_sms_encode_reply_response(const feetech_sms_reply_response_t *m, uin
     uint32_t values[2];
     if (m == NULL || buf == NULL || len == NULL) { return FEETECH_SMS_E_ARG; }
     *len = 0u;
+    if (!FEETECH_SMS_ENCODES_RESPONSES) { return FEETECH_SMS_E_ARG; } /* left out of this build */
     if ((m->id > 253u) && m->id != 254u) { return FEETECH_SMS_E_RANGE; } /* id */
     values[0] = (uint32_t)m->id;
     values[1] = (uint32_t)m->error;
@@ -1480,24 +1505,42 @@ int feetech_sms_encode(const feetech_sms_msg_t *msg, uint8_t *buf, size_t cap, s
     }
     *len = 0u;
     switch (msg->kind) {
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_PING_REQUEST:
         return feetech_sms_encode_ping_request(&msg->u.ping_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_READ_REQUEST:
         return feetech_sms_encode_read_request(&msg->u.read_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_WRITE_REQUEST:
         return feetech_sms_encode_write_request(&msg->u.write_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_REG_WRITE_REQUEST:
         return feetech_sms_encode_reg_write_request(&msg->u.reg_write_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_ACTION_REQUEST:
         return feetech_sms_encode_action_request(&msg->u.action_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_RESET_REQUEST:
         return feetech_sms_encode_reset_request(&msg->u.reset_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_SYNC_READ_REQUEST:
         return feetech_sms_encode_sync_read_request(&msg->u.sync_read_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_REQUESTS
     case FEETECH_SMS_SYNC_WRITE_REQUEST:
         return feetech_sms_encode_sync_write_request(&msg->u.sync_write_request, buf, cap, len);
+#endif
+#if FEETECH_SMS_ENCODES_RESPONSES
     case FEETECH_SMS_REPLY_RESPONSE:
         return feetech_sms_encode_reply_response(&msg->u.reply_response, buf, cap, len);
+#endif
     default:
         return FEETECH_SMS_E_ARG;
     }
@@ -1585,9 +1628,9 @@ static int feetech_sms__scan(feetech_sms_parser_t *p, feetech_sms_msg_t *out)
             continue;
         }
         if (v[pos] == FEETECH_SMS__C_SIZED) {
-            size = feetech_sms__size(p->dir, p->buf + pos);
+            size = feetech_sms__size(FEETECH_SMS__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (feetech_sms_decode(p->buf + pos, size, p->dir, out) == FEETECH_SMS_OK) {
+                if (feetech_sms_decode(p->buf + pos, size, FEETECH_SMS__RX(p->dir), out) == FEETECH_SMS_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -1654,7 +1697,7 @@ static void feetech_sms__front(feetech_sms_parser_t *p)
  * scan runs only when a sized candidate ends with it (p->wake) or no candidate is held at the front. */
 static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
 {
-    const size_t need = (p->dir == FEETECH_SMS_REQUEST ? 5u : 4u);
+    const size_t need = (FEETECH_SMS__RX(p->dir) == FEETECH_SMS_REQUEST ? 5u : 4u);
     size_t at, size, end, first = p->first, n = p->n, wake = p->wake;
     uint8_t *const b = p->buf, *const v = p->verdict;
     if (first + n == FEETECH_SMS_MAX_FRAME) {
@@ -1674,7 +1717,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     }
     if (n >= need && v[end - need] == FEETECH_SMS__C_NEW) {
         at = end - need;
-        size = feetech_sms__size(p->dir, b + at);
+        size = feetech_sms__size(FEETECH_SMS__RX(p->dir), b + at);
         if (size == 0u) {
             v[at] = 0u;
         } else {
@@ -1699,6 +1742,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     return 0;
 }
 
+#if FEETECH_SMS_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
@@ -1706,10 +1750,10 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
     const size_t hl = 2u;
     const uint8_t *h = feetech_sms__h_request_0;
     size_t i, size;
-    if (len < (p->dir == FEETECH_SMS_REQUEST ? 5u : 4u) || !feetech_sms__same(data, h, hl)) {
+    if (len < (FEETECH_SMS__RX(p->dir) == FEETECH_SMS_REQUEST ? 5u : 4u) || !feetech_sms__same(data, h, hl)) {
         return 0u;
     }
-    size = feetech_sms__size(p->dir, data);
+    size = feetech_sms__size(FEETECH_SMS__RX(p->dir), data);
     if (size == 0u || size > len) {
         return 0u;
     }
@@ -1718,18 +1762,25 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
             return 0u;
         }
     }
-    if (feetech_sms_decode(data, size, p->dir, out) != FEETECH_SMS_OK) {
+    if (feetech_sms_decode(data, size, FEETECH_SMS__RX(p->dir), out) != FEETECH_SMS_OK) {
         return 0u;
     }
     p->frames++;
     return size;
 }
+#endif
 
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
+#if FEETECH_SMS_ROLE != FEETECH_SMS_ROLE_BOTH
+    if (!FEETECH_SMS__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
+#if FEETECH_SMS_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = feetech_sms__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -1737,6 +1788,7 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
                 return i + size;
             }
         }
+#endif
         if (feetech_sms__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -25,6 +25,16 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
 #define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
 #define HIWONDER_RRC__TABLES (HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (HIWONDER_RRC_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define HIWONDER_RRC__DECODES(dir) ((dir) == HIWONDER_RRC_REQUEST ? HIWONDER_RRC_DECODES_REQUESTS : (dir) == HIWONDER_RRC_RESPONSE && HIWONDER_RRC_DECODES_RESPONSES)
+#if HIWONDER_RRC_DECODES_REQUESTS && !HIWONDER_RRC_DECODES_RESPONSES
+#define HIWONDER_RRC__RX(dir) HIWONDER_RRC_REQUEST
+#elif HIWONDER_RRC_DECODES_RESPONSES && !HIWONDER_RRC_DECODES_REQUESTS
+#define HIWONDER_RRC__RX(dir) HIWONDER_RRC_RESPONSE
+#else
+#define HIWONDER_RRC__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -230,7 +240,10 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2299,6 +2312,9 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
         return HIWONDER_RRC_E_ARG;
     }
     out->kind = HIWONDER_RRC_KIND_NONE;
+    if (!HIWONDER_RRC__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return HIWONDER_RRC_E_ARG;
+    }
     count = hiwonder_rrc__count(dir);
     if (count == 0u) {
         return HIWONDER_RRC_E_ARG;
@@ -3598,6 +3614,7 @@ int hiwonder_rrc_encode_led_request(const hiwonder_rrc_led_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 1UL, values, m, hiwonder_rrc__enc_led_request, buf, cap, len);
 }
@@ -3608,6 +3625,7 @@ int hiwonder_rrc_encode_buzzer_request(const hiwonder_rrc_buzzer_request_t *m, u
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 2UL, values, m, hiwonder_rrc__enc_buzzer_request, buf, cap, len);
 }
@@ -3618,6 +3636,7 @@ int hiwonder_rrc_encode_motor_set_speed_request(const hiwonder_rrc_motor_set_spe
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 3UL, values, m, hiwonder_rrc__enc_motor_set_speed_request, buf, cap, len);
 }
@@ -3628,6 +3647,7 @@ int hiwonder_rrc_encode_motor_set_speeds_request(const hiwonder_rrc_motor_set_sp
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 3UL, values, m, hiwonder_rrc__enc_motor_set_speeds_request, buf, cap, len);
 }
@@ -3638,6 +3658,7 @@ int hiwonder_rrc_encode_motor_stop_request(const hiwonder_rrc_motor_stop_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 3UL, values, m, hiwonder_rrc__enc_motor_stop_request, buf, cap, len);
 }
@@ -3648,6 +3669,7 @@ int hiwonder_rrc_encode_motor_set_duties_request(const hiwonder_rrc_motor_set_du
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 3UL, values, m, hiwonder_rrc__enc_motor_set_duties_request, buf, cap, len);
 }
@@ -3658,6 +3680,7 @@ int hiwonder_rrc_encode_motor_stop_mask_request(const hiwonder_rrc_motor_stop_ma
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 3UL, values, m, hiwonder_rrc__enc_motor_stop_mask_request, buf, cap, len);
 }
@@ -3668,6 +3691,7 @@ int hiwonder_rrc_encode_pwm_servo_set_positions_request(const hiwonder_rrc_pwm_s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_set_positions_request, buf, cap, len);
 }
@@ -3678,6 +3702,7 @@ int hiwonder_rrc_encode_pwm_servo_set_position_request(const hiwonder_rrc_pwm_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_set_position_request, buf, cap, len);
 }
@@ -3688,6 +3713,7 @@ int hiwonder_rrc_encode_pwm_servo_read_position_request(const hiwonder_rrc_pwm_s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_read_position_request, buf, cap, len);
 }
@@ -3698,6 +3724,7 @@ int hiwonder_rrc_encode_pwm_servo_read_position_response(const hiwonder_rrc_pwm_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_read_position_response, buf, cap, len);
 }
@@ -3708,6 +3735,7 @@ int hiwonder_rrc_encode_pwm_servo_set_offset_request(const hiwonder_rrc_pwm_serv
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_set_offset_request, buf, cap, len);
 }
@@ -3718,6 +3746,7 @@ int hiwonder_rrc_encode_pwm_servo_read_offset_request(const hiwonder_rrc_pwm_ser
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_read_offset_request, buf, cap, len);
 }
@@ -3728,6 +3757,7 @@ int hiwonder_rrc_encode_pwm_servo_read_offset_response(const hiwonder_rrc_pwm_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 4UL, values, m, hiwonder_rrc__enc_pwm_servo_read_offset_response, buf, cap, len);
 }
@@ -3738,6 +3768,7 @@ int hiwonder_rrc_encode_bus_servo_set_positions_request(const hiwonder_rrc_bus_s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_positions_request, buf, cap, len);
 }
@@ -3748,6 +3779,7 @@ int hiwonder_rrc_encode_bus_servo_read_position_request(const hiwonder_rrc_bus_s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_position_request, buf, cap, len);
 }
@@ -3758,6 +3790,7 @@ int hiwonder_rrc_encode_bus_servo_read_position_response(const hiwonder_rrc_bus_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_position_response, buf, cap, len);
 }
@@ -3768,6 +3801,7 @@ int hiwonder_rrc_encode_bus_servo_read_voltage_request(const hiwonder_rrc_bus_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_voltage_request, buf, cap, len);
 }
@@ -3778,6 +3812,7 @@ int hiwonder_rrc_encode_bus_servo_read_voltage_response(const hiwonder_rrc_bus_s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_voltage_response, buf, cap, len);
 }
@@ -3788,6 +3823,7 @@ int hiwonder_rrc_encode_bus_servo_read_temperature_request(const hiwonder_rrc_bu
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_temperature_request, buf, cap, len);
 }
@@ -3798,6 +3834,7 @@ int hiwonder_rrc_encode_bus_servo_read_temperature_response(const hiwonder_rrc_b
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_temperature_response, buf, cap, len);
 }
@@ -3808,6 +3845,7 @@ int hiwonder_rrc_encode_bus_servo_stop_request(const hiwonder_rrc_bus_servo_stop
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_stop_request, buf, cap, len);
 }
@@ -3818,6 +3856,7 @@ int hiwonder_rrc_encode_bus_servo_read_torque_request(const hiwonder_rrc_bus_ser
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_torque_request, buf, cap, len);
 }
@@ -3828,6 +3867,7 @@ int hiwonder_rrc_encode_bus_servo_read_torque_response(const hiwonder_rrc_bus_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_torque_response, buf, cap, len);
 }
@@ -3838,6 +3878,7 @@ int hiwonder_rrc_encode_bus_servo_unload_request(const hiwonder_rrc_bus_servo_un
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_unload_request, buf, cap, len);
 }
@@ -3848,6 +3889,7 @@ int hiwonder_rrc_encode_bus_servo_load_request(const hiwonder_rrc_bus_servo_load
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_load_request, buf, cap, len);
 }
@@ -3858,6 +3900,7 @@ int hiwonder_rrc_encode_bus_servo_set_id_request(const hiwonder_rrc_bus_servo_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_id_request, buf, cap, len);
 }
@@ -3868,6 +3911,7 @@ int hiwonder_rrc_encode_bus_servo_read_id_request(const hiwonder_rrc_bus_servo_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_id_request, buf, cap, len);
 }
@@ -3878,6 +3922,7 @@ int hiwonder_rrc_encode_bus_servo_read_id_response(const hiwonder_rrc_bus_servo_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_id_response, buf, cap, len);
 }
@@ -3888,6 +3933,7 @@ int hiwonder_rrc_encode_bus_servo_set_offset_request(const hiwonder_rrc_bus_serv
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_offset_request, buf, cap, len);
 }
@@ -3898,6 +3944,7 @@ int hiwonder_rrc_encode_bus_servo_read_offset_request(const hiwonder_rrc_bus_ser
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_offset_request, buf, cap, len);
 }
@@ -3908,6 +3955,7 @@ int hiwonder_rrc_encode_bus_servo_read_offset_response(const hiwonder_rrc_bus_se
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_offset_response, buf, cap, len);
 }
@@ -3918,6 +3966,7 @@ int hiwonder_rrc_encode_bus_servo_save_offset_request(const hiwonder_rrc_bus_ser
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_save_offset_request, buf, cap, len);
 }
@@ -3928,6 +3977,7 @@ int hiwonder_rrc_encode_bus_servo_set_position_limit_request(const hiwonder_rrc_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_position_limit_request, buf, cap, len);
 }
@@ -3938,6 +3988,7 @@ int hiwonder_rrc_encode_bus_servo_read_position_limit_request(const hiwonder_rrc
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_position_limit_request, buf, cap, len);
 }
@@ -3948,6 +3999,7 @@ int hiwonder_rrc_encode_bus_servo_read_position_limit_response(const hiwonder_rr
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_position_limit_response, buf, cap, len);
 }
@@ -3958,6 +4010,7 @@ int hiwonder_rrc_encode_bus_servo_set_voltage_limit_request(const hiwonder_rrc_b
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_voltage_limit_request, buf, cap, len);
 }
@@ -3968,6 +4021,7 @@ int hiwonder_rrc_encode_bus_servo_read_voltage_limit_request(const hiwonder_rrc_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_voltage_limit_request, buf, cap, len);
 }
@@ -3978,6 +4032,7 @@ int hiwonder_rrc_encode_bus_servo_read_voltage_limit_response(const hiwonder_rrc
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_voltage_limit_response, buf, cap, len);
 }
@@ -3988,6 +4043,7 @@ int hiwonder_rrc_encode_bus_servo_set_temperature_limit_request(const hiwonder_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_set_temperature_limit_request, buf, cap, len);
 }
@@ -3998,6 +4054,7 @@ int hiwonder_rrc_encode_bus_servo_read_temperature_limit_request(const hiwonder_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_temperature_limit_request, buf, cap, len);
 }
@@ -4008,6 +4065,7 @@ int hiwonder_rrc_encode_bus_servo_read_temperature_limit_response(const hiwonder
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 5UL, values, m, hiwonder_rrc__enc_bus_servo_read_temperature_limit_response, buf, cap, len);
 }
@@ -4018,6 +4076,7 @@ int hiwonder_rrc_encode_key_response(const hiwonder_rrc_key_response_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 6UL, values, m, hiwonder_rrc__enc_key_response, buf, cap, len);
 }
@@ -4028,6 +4087,7 @@ int hiwonder_rrc_encode_imu_response(const hiwonder_rrc_imu_response_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 7UL, values, m, hiwonder_rrc__enc_imu_response, buf, cap, len);
 }
@@ -4038,6 +4098,7 @@ int hiwonder_rrc_encode_gamepad_response(const hiwonder_rrc_gamepad_response_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 8UL, values, m, hiwonder_rrc__enc_gamepad_response, buf, cap, len);
 }
@@ -4048,6 +4109,7 @@ int hiwonder_rrc_encode_sbus_response(const hiwonder_rrc_sbus_response_t *m, uin
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 9UL, values, m, hiwonder_rrc__enc_sbus_response, buf, cap, len);
 }
@@ -4058,6 +4120,7 @@ int hiwonder_rrc_encode_system_battery_response(const hiwonder_rrc_system_batter
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_RESPONSES) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_RESPONSE, 0UL, values, m, hiwonder_rrc__enc_system_battery_response, buf, cap, len);
 }
@@ -4068,6 +4131,7 @@ int hiwonder_rrc_encode_oled_request(const hiwonder_rrc_oled_request_t *m, uint8
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 10UL, values, m, hiwonder_rrc__enc_oled_request, buf, cap, len);
 }
@@ -4078,6 +4142,7 @@ int hiwonder_rrc_encode_rgb_set_pixels_request(const hiwonder_rrc_rgb_set_pixels
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return HIWONDER_RRC_E_ARG; }
     *len = 0u;
+    if (!HIWONDER_RRC_ENCODES_REQUESTS) { return HIWONDER_RRC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return hiwonder_rrc__frame(HIWONDER_RRC_REQUEST, 11UL, values, m, hiwonder_rrc__enc_rgb_set_pixels_request, buf, cap, len);
 }
@@ -4089,104 +4154,202 @@ int hiwonder_rrc_encode(const hiwonder_rrc_msg_t *msg, uint8_t *buf, size_t cap,
     }
     *len = 0u;
     switch (msg->kind) {
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_LED_REQUEST:
         return hiwonder_rrc_encode_led_request(&msg->u.led_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUZZER_REQUEST:
         return hiwonder_rrc_encode_buzzer_request(&msg->u.buzzer_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_MOTOR_SET_SPEED_REQUEST:
         return hiwonder_rrc_encode_motor_set_speed_request(&msg->u.motor_set_speed_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_MOTOR_SET_SPEEDS_REQUEST:
         return hiwonder_rrc_encode_motor_set_speeds_request(&msg->u.motor_set_speeds_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_MOTOR_STOP_REQUEST:
         return hiwonder_rrc_encode_motor_stop_request(&msg->u.motor_stop_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_MOTOR_SET_DUTIES_REQUEST:
         return hiwonder_rrc_encode_motor_set_duties_request(&msg->u.motor_set_duties_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_MOTOR_STOP_MASK_REQUEST:
         return hiwonder_rrc_encode_motor_stop_mask_request(&msg->u.motor_stop_mask_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_PWM_SERVO_SET_POSITIONS_REQUEST:
         return hiwonder_rrc_encode_pwm_servo_set_positions_request(&msg->u.pwm_servo_set_positions_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_PWM_SERVO_SET_POSITION_REQUEST:
         return hiwonder_rrc_encode_pwm_servo_set_position_request(&msg->u.pwm_servo_set_position_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_PWM_SERVO_READ_POSITION_REQUEST:
         return hiwonder_rrc_encode_pwm_servo_read_position_request(&msg->u.pwm_servo_read_position_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_PWM_SERVO_READ_POSITION_RESPONSE:
         return hiwonder_rrc_encode_pwm_servo_read_position_response(&msg->u.pwm_servo_read_position_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_PWM_SERVO_SET_OFFSET_REQUEST:
         return hiwonder_rrc_encode_pwm_servo_set_offset_request(&msg->u.pwm_servo_set_offset_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_PWM_SERVO_READ_OFFSET_REQUEST:
         return hiwonder_rrc_encode_pwm_servo_read_offset_request(&msg->u.pwm_servo_read_offset_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_PWM_SERVO_READ_OFFSET_RESPONSE:
         return hiwonder_rrc_encode_pwm_servo_read_offset_response(&msg->u.pwm_servo_read_offset_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_POSITIONS_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_positions_request(&msg->u.bus_servo_set_positions_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_POSITION_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_position_request(&msg->u.bus_servo_read_position_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_POSITION_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_position_response(&msg->u.bus_servo_read_position_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_VOLTAGE_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_voltage_request(&msg->u.bus_servo_read_voltage_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_VOLTAGE_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_voltage_response(&msg->u.bus_servo_read_voltage_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_TEMPERATURE_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_temperature_request(&msg->u.bus_servo_read_temperature_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_TEMPERATURE_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_temperature_response(&msg->u.bus_servo_read_temperature_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_STOP_REQUEST:
         return hiwonder_rrc_encode_bus_servo_stop_request(&msg->u.bus_servo_stop_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_TORQUE_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_torque_request(&msg->u.bus_servo_read_torque_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_TORQUE_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_torque_response(&msg->u.bus_servo_read_torque_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_UNLOAD_REQUEST:
         return hiwonder_rrc_encode_bus_servo_unload_request(&msg->u.bus_servo_unload_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_LOAD_REQUEST:
         return hiwonder_rrc_encode_bus_servo_load_request(&msg->u.bus_servo_load_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_ID_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_id_request(&msg->u.bus_servo_set_id_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_ID_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_id_request(&msg->u.bus_servo_read_id_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_ID_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_id_response(&msg->u.bus_servo_read_id_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_OFFSET_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_offset_request(&msg->u.bus_servo_set_offset_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_OFFSET_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_offset_request(&msg->u.bus_servo_read_offset_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_OFFSET_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_offset_response(&msg->u.bus_servo_read_offset_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SAVE_OFFSET_REQUEST:
         return hiwonder_rrc_encode_bus_servo_save_offset_request(&msg->u.bus_servo_save_offset_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_POSITION_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_position_limit_request(&msg->u.bus_servo_set_position_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_POSITION_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_position_limit_request(&msg->u.bus_servo_read_position_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_POSITION_LIMIT_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_position_limit_response(&msg->u.bus_servo_read_position_limit_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_VOLTAGE_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_voltage_limit_request(&msg->u.bus_servo_set_voltage_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_VOLTAGE_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_voltage_limit_request(&msg->u.bus_servo_read_voltage_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_VOLTAGE_LIMIT_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_voltage_limit_response(&msg->u.bus_servo_read_voltage_limit_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_SET_TEMPERATURE_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_set_temperature_limit_request(&msg->u.bus_servo_set_temperature_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_BUS_SERVO_READ_TEMPERATURE_LIMIT_REQUEST:
         return hiwonder_rrc_encode_bus_servo_read_temperature_limit_request(&msg->u.bus_servo_read_temperature_limit_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_BUS_SERVO_READ_TEMPERATURE_LIMIT_RESPONSE:
         return hiwonder_rrc_encode_bus_servo_read_temperature_limit_response(&msg->u.bus_servo_read_temperature_limit_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_KEY_RESPONSE:
         return hiwonder_rrc_encode_key_response(&msg->u.key_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_IMU_RESPONSE:
         return hiwonder_rrc_encode_imu_response(&msg->u.imu_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_GAMEPAD_RESPONSE:
         return hiwonder_rrc_encode_gamepad_response(&msg->u.gamepad_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_SBUS_RESPONSE:
         return hiwonder_rrc_encode_sbus_response(&msg->u.sbus_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_RESPONSES
     case HIWONDER_RRC_SYSTEM_BATTERY_RESPONSE:
         return hiwonder_rrc_encode_system_battery_response(&msg->u.system_battery_response, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_OLED_REQUEST:
         return hiwonder_rrc_encode_oled_request(&msg->u.oled_request, buf, cap, len);
+#endif
+#if HIWONDER_RRC_ENCODES_REQUESTS
     case HIWONDER_RRC_RGB_SET_PIXELS_REQUEST:
         return hiwonder_rrc_encode_rgb_set_pixels_request(&msg->u.rgb_set_pixels_request, buf, cap, len);
+#endif
     default:
         return HIWONDER_RRC_E_ARG;
     }
@@ -4272,9 +4435,9 @@ static int hiwonder_rrc__scan(hiwonder_rrc_parser_t *p, hiwonder_rrc_msg_t *out)
             continue;
         }
         if (v[pos] == HIWONDER_RRC__C_SIZED) {
-            size = hiwonder_rrc__size(p->dir, p->buf + pos);
+            size = hiwonder_rrc__size(HIWONDER_RRC__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (hiwonder_rrc_decode(p->buf + pos, size, p->dir, out) == HIWONDER_RRC_OK) {
+                if (hiwonder_rrc_decode(p->buf + pos, size, HIWONDER_RRC__RX(p->dir), out) == HIWONDER_RRC_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -4361,7 +4524,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     }
     if (n >= need && v[end - need] == HIWONDER_RRC__C_NEW) {
         at = end - need;
-        size = hiwonder_rrc__size(p->dir, b + at);
+        size = hiwonder_rrc__size(HIWONDER_RRC__RX(p->dir), b + at);
         if (size == 0u) {
             v[at] = 0u;
         } else {
@@ -4386,6 +4549,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     return 0;
 }
 
+#if HIWONDER_RRC_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
@@ -4396,7 +4560,7 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
     if (len < 4u || !hiwonder_rrc__same(data, h, hl)) {
         return 0u;
     }
-    size = hiwonder_rrc__size(p->dir, data);
+    size = hiwonder_rrc__size(HIWONDER_RRC__RX(p->dir), data);
     if (size == 0u || size > len) {
         return 0u;
     }
@@ -4405,18 +4569,25 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (hiwonder_rrc_decode(data, size, p->dir, out) != HIWONDER_RRC_OK) {
+    if (hiwonder_rrc_decode(data, size, HIWONDER_RRC__RX(p->dir), out) != HIWONDER_RRC_OK) {
         return 0u;
     }
     p->frames++;
     return size;
 }
+#endif
 
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
+#if HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_BOTH
+    if (!HIWONDER_RRC__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
+#if HIWONDER_RRC_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4424,6 +4595,7 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
                 return i + size;
             }
         }
+#endif
         if (hiwonder_rrc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -28,6 +28,31 @@ extern "C" {
 #define HIWONDER_RRC_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. HIWONDER_RRC_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); HIWONDER_RRC_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * HIWONDER_RRC_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (HIWONDER_RRC_E_ARG). */
+#define HIWONDER_RRC_ROLE_HOST 1
+#define HIWONDER_RRC_ROLE_DEVICE 2
+#define HIWONDER_RRC_ROLE_BOTH 3
+#ifndef HIWONDER_RRC_ROLE
+#define HIWONDER_RRC_ROLE HIWONDER_RRC_ROLE_BOTH
+#endif
+#if HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_HOST && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_DEVICE && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_BOTH
+#error "HIWONDER_RRC_ROLE must be HIWONDER_RRC_ROLE_HOST, HIWONDER_RRC_ROLE_DEVICE or HIWONDER_RRC_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define HIWONDER_RRC_ENCODES_REQUESTS (HIWONDER_RRC_ENABLE_ENCODE && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_DEVICE)
+#define HIWONDER_RRC_ENCODES_RESPONSES (HIWONDER_RRC_ENABLE_ENCODE && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_HOST)
+#define HIWONDER_RRC_DECODES_REQUESTS (HIWONDER_RRC_ENABLE_DECODE && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_HOST)
+#define HIWONDER_RRC_DECODES_RESPONSES (HIWONDER_RRC_ENABLE_DECODE && HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef HIWONDER_RRC_PARSER_WHOLE_FRAMES
+#define HIWONDER_RRC_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 260 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef HIWONDER_RRC_MAX_FRAME

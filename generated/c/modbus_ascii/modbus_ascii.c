@@ -25,6 +25,16 @@ typedef char modbus_ascii__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_ASCII__LENGTHS 0 /* every layout has a length element */
 #define MODBUS_ASCII__SINGLE 1 /* one layout per direction */
 #define MODBUS_ASCII__TABLES (MODBUS_ASCII_ENABLE_ENCODE || MODBUS_ASCII__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (MODBUS_ASCII_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define MODBUS_ASCII__DECODES(dir) ((dir) == MODBUS_ASCII_REQUEST ? MODBUS_ASCII_DECODES_REQUESTS : (dir) == MODBUS_ASCII_RESPONSE && MODBUS_ASCII_DECODES_RESPONSES)
+#if MODBUS_ASCII_DECODES_REQUESTS && !MODBUS_ASCII_DECODES_RESPONSES
+#define MODBUS_ASCII__RX(dir) MODBUS_ASCII_REQUEST
+#elif MODBUS_ASCII_DECODES_RESPONSES && !MODBUS_ASCII_DECODES_REQUESTS
+#define MODBUS_ASCII__RX(dir) MODBUS_ASCII_RESPONSE
+#else
+#define MODBUS_ASCII__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum negated. */
@@ -288,7 +298,10 @@ static int modbus_ascii__rewrite(const modbus_ascii__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1583,6 +1596,9 @@ int modbus_ascii_decode_expect(const uint8_t *frame, size_t len, modbus_ascii_di
         return MODBUS_ASCII_E_ARG;
     }
     out->kind = MODBUS_ASCII_KIND_NONE;
+    if (!MODBUS_ASCII__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return MODBUS_ASCII_E_ARG;
+    }
     count = modbus_ascii__count(dir);
     if (count == 0u) {
         return MODBUS_ASCII_E_ARG;
@@ -2178,6 +2194,7 @@ int modbus_ascii_encode_read_coils_request(const modbus_ascii_read_coils_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 1UL, values, m, modbus_ascii__enc_read_coils_request, buf, cap, len);
@@ -2189,6 +2206,7 @@ int modbus_ascii_encode_read_coils_response(const modbus_ascii_read_coils_respon
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 1UL, values, m, modbus_ascii__enc_read_coils_response, buf, cap, len);
@@ -2200,6 +2218,7 @@ int modbus_ascii_encode_read_discrete_inputs_request(const modbus_ascii_read_dis
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 2UL, values, m, modbus_ascii__enc_read_discrete_inputs_request, buf, cap, len);
@@ -2211,6 +2230,7 @@ int modbus_ascii_encode_read_discrete_inputs_response(const modbus_ascii_read_di
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 2UL, values, m, modbus_ascii__enc_read_discrete_inputs_response, buf, cap, len);
@@ -2222,6 +2242,7 @@ int modbus_ascii_encode_read_holding_registers_request(const modbus_ascii_read_h
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 3UL, values, m, modbus_ascii__enc_read_holding_registers_request, buf, cap, len);
@@ -2233,6 +2254,7 @@ int modbus_ascii_encode_read_holding_registers_response(const modbus_ascii_read_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 3UL, values, m, modbus_ascii__enc_read_holding_registers_response, buf, cap, len);
@@ -2244,6 +2266,7 @@ int modbus_ascii_encode_read_input_registers_request(const modbus_ascii_read_inp
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 4UL, values, m, modbus_ascii__enc_read_input_registers_request, buf, cap, len);
@@ -2255,6 +2278,7 @@ int modbus_ascii_encode_read_input_registers_response(const modbus_ascii_read_in
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 4UL, values, m, modbus_ascii__enc_read_input_registers_response, buf, cap, len);
@@ -2266,6 +2290,7 @@ int modbus_ascii_encode_write_coil_request(const modbus_ascii_write_coil_request
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 5UL, values, m, modbus_ascii__enc_write_coil_request, buf, cap, len);
@@ -2277,6 +2302,7 @@ int modbus_ascii_encode_write_coil_response(const modbus_ascii_write_coil_respon
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 5UL, values, m, modbus_ascii__enc_write_coil_response, buf, cap, len);
@@ -2288,6 +2314,7 @@ int modbus_ascii_encode_write_register_request(const modbus_ascii_write_register
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 6UL, values, m, modbus_ascii__enc_write_register_request, buf, cap, len);
@@ -2299,6 +2326,7 @@ int modbus_ascii_encode_write_register_response(const modbus_ascii_write_registe
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 6UL, values, m, modbus_ascii__enc_write_register_response, buf, cap, len);
@@ -2310,6 +2338,7 @@ int modbus_ascii_encode_write_coils_request(const modbus_ascii_write_coils_reque
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 15UL, values, m, modbus_ascii__enc_write_coils_request, buf, cap, len);
@@ -2321,6 +2350,7 @@ int modbus_ascii_encode_write_coils_response(const modbus_ascii_write_coils_resp
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 15UL, values, m, modbus_ascii__enc_write_coils_response, buf, cap, len);
@@ -2332,6 +2362,7 @@ int modbus_ascii_encode_write_registers_request(const modbus_ascii_write_registe
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 16UL, values, m, modbus_ascii__enc_write_registers_request, buf, cap, len);
@@ -2343,6 +2374,7 @@ int modbus_ascii_encode_write_registers_response(const modbus_ascii_write_regist
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 16UL, values, m, modbus_ascii__enc_write_registers_response, buf, cap, len);
@@ -2354,6 +2386,7 @@ int modbus_ascii_encode_mask_write_register_request(const modbus_ascii_mask_writ
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 22UL, values, m, modbus_ascii__enc_mask_write_register_request, buf, cap, len);
@@ -2365,6 +2398,7 @@ int modbus_ascii_encode_mask_write_register_response(const modbus_ascii_mask_wri
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 22UL, values, m, modbus_ascii__enc_mask_write_register_response, buf, cap, len);
@@ -2376,6 +2410,7 @@ int modbus_ascii_encode_read_write_registers_request(const modbus_ascii_read_wri
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_REQUESTS) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_REQUEST, 23UL, values, m, modbus_ascii__enc_read_write_registers_request, buf, cap, len);
@@ -2387,6 +2422,7 @@ int modbus_ascii_encode_read_write_registers_response(const modbus_ascii_read_wr
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_ascii__frame(MODBUS_ASCII_RESPONSE, 23UL, values, m, modbus_ascii__enc_read_write_registers_response, buf, cap, len);
@@ -2398,6 +2434,7 @@ int modbus_ascii_encode_exception_response(const modbus_ascii_exception_response
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_ASCII_E_ARG; }
     *len = 0u;
+    if (!MODBUS_ASCII_ENCODES_RESPONSES) { return MODBUS_ASCII_E_ARG; } /* left out of this build */
     if ((m->function & 128u) != 0u) { return MODBUS_ASCII_E_RANGE; }
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_ASCII_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
@@ -2411,48 +2448,90 @@ int modbus_ascii_encode(const modbus_ascii_msg_t *msg, uint8_t *buf, size_t cap,
     }
     *len = 0u;
     switch (msg->kind) {
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_READ_COILS_REQUEST:
         return modbus_ascii_encode_read_coils_request(&msg->u.read_coils_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_READ_COILS_RESPONSE:
         return modbus_ascii_encode_read_coils_response(&msg->u.read_coils_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_READ_DISCRETE_INPUTS_REQUEST:
         return modbus_ascii_encode_read_discrete_inputs_request(&msg->u.read_discrete_inputs_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_READ_DISCRETE_INPUTS_RESPONSE:
         return modbus_ascii_encode_read_discrete_inputs_response(&msg->u.read_discrete_inputs_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_READ_HOLDING_REGISTERS_REQUEST:
         return modbus_ascii_encode_read_holding_registers_request(&msg->u.read_holding_registers_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_READ_HOLDING_REGISTERS_RESPONSE:
         return modbus_ascii_encode_read_holding_registers_response(&msg->u.read_holding_registers_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_READ_INPUT_REGISTERS_REQUEST:
         return modbus_ascii_encode_read_input_registers_request(&msg->u.read_input_registers_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_READ_INPUT_REGISTERS_RESPONSE:
         return modbus_ascii_encode_read_input_registers_response(&msg->u.read_input_registers_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_WRITE_COIL_REQUEST:
         return modbus_ascii_encode_write_coil_request(&msg->u.write_coil_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_WRITE_COIL_RESPONSE:
         return modbus_ascii_encode_write_coil_response(&msg->u.write_coil_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_WRITE_REGISTER_REQUEST:
         return modbus_ascii_encode_write_register_request(&msg->u.write_register_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_WRITE_REGISTER_RESPONSE:
         return modbus_ascii_encode_write_register_response(&msg->u.write_register_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_WRITE_COILS_REQUEST:
         return modbus_ascii_encode_write_coils_request(&msg->u.write_coils_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_WRITE_COILS_RESPONSE:
         return modbus_ascii_encode_write_coils_response(&msg->u.write_coils_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_WRITE_REGISTERS_REQUEST:
         return modbus_ascii_encode_write_registers_request(&msg->u.write_registers_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_WRITE_REGISTERS_RESPONSE:
         return modbus_ascii_encode_write_registers_response(&msg->u.write_registers_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_MASK_WRITE_REGISTER_REQUEST:
         return modbus_ascii_encode_mask_write_register_request(&msg->u.mask_write_register_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_MASK_WRITE_REGISTER_RESPONSE:
         return modbus_ascii_encode_mask_write_register_response(&msg->u.mask_write_register_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_REQUESTS
     case MODBUS_ASCII_READ_WRITE_REGISTERS_REQUEST:
         return modbus_ascii_encode_read_write_registers_request(&msg->u.read_write_registers_request, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_READ_WRITE_REGISTERS_RESPONSE:
         return modbus_ascii_encode_read_write_registers_response(&msg->u.read_write_registers_response, buf, cap, len);
+#endif
+#if MODBUS_ASCII_ENCODES_RESPONSES
     case MODBUS_ASCII_EXCEPTION_RESPONSE:
         return modbus_ascii_encode_exception_response(&msg->u.exception_response, buf, cap, len);
+#endif
     default:
         return MODBUS_ASCII_E_ARG;
     }
@@ -2477,13 +2556,13 @@ void modbus_ascii_parser_init(modbus_ascii_parser_t *parser, modbus_ascii_direct
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_msg_t *out, size_t *size)
 {
-    uint8_t count = modbus_ascii__count(p->dir), k;
+    uint8_t count = modbus_ascii__count(MODBUS_ASCII__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = modbus_ascii__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = modbus_ascii__probe_at(MODBUS_ASCII__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == MODBUS_ASCII__WAIT) {
             need = 0u;
             continue;
@@ -2497,7 +2576,7 @@ static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_
             }
             continue;
         }
-        if (modbus_ascii_decode(p->buf + pos, (size_t)s, p->dir, out) != MODBUS_ASCII_OK) {
+        if (modbus_ascii_decode(p->buf + pos, (size_t)s, MODBUS_ASCII__RX(p->dir), out) != MODBUS_ASCII_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_ASCII__V_CORRUPT;
             }
@@ -2518,7 +2597,7 @@ static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_
 static size_t modbus_ascii__next(modbus_ascii_parser_t *p, size_t start)
 {
 #if MODBUS_ASCII__HEADERS
-    uint8_t count = modbus_ascii__count(p->dir), k;
+    uint8_t count = modbus_ascii__count(MODBUS_ASCII__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2527,7 +2606,7 @@ static size_t modbus_ascii__next(modbus_ascii_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = modbus_ascii__header(p->dir, k, &hl);
+            const uint8_t *h = modbus_ascii__header(MODBUS_ASCII__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (modbus_ascii__same(p->buf + pos, h, hl)) {
@@ -2565,10 +2644,10 @@ static void modbus_ascii__drop(modbus_ascii_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int modbus_ascii__ends_header(const modbus_ascii_parser_t *p)
 {
-    uint8_t count = modbus_ascii__count(p->dir), k;
+    uint8_t count = modbus_ascii__count(MODBUS_ASCII__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = modbus_ascii__header(p->dir, k, &hl);
+        const uint8_t *h = modbus_ascii__header(MODBUS_ASCII__RX(p->dir), k, &hl);
         if (hl <= p->n && modbus_ascii__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2650,7 +2729,7 @@ static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_asc
     return got;
 }
 
-#if MODBUS_ASCII__HEADERS
+#if MODBUS_ASCII__HEADERS && MODBUS_ASCII_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through modbus_ascii__push. */
@@ -2659,14 +2738,14 @@ static size_t modbus_ascii__whole(modbus_ascii_parser_t *p, const uint8_t *data,
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!MODBUS_ASCII__SINGLE && modbus_ascii__count(p->dir) != 1u) {
+    if (!MODBUS_ASCII__SINGLE && modbus_ascii__count(MODBUS_ASCII__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = modbus_ascii__header(p->dir, 0u, &hl);
+    h = modbus_ascii__header(MODBUS_ASCII__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !modbus_ascii__same(data, h, hl)) {
         return 0u;
     }
-    s = modbus_ascii__probe_at(p->dir, 0u, data, len);
+    s = modbus_ascii__probe_at(MODBUS_ASCII__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > MODBUS_ASCII_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2676,7 +2755,7 @@ static size_t modbus_ascii__whole(modbus_ascii_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (modbus_ascii_decode(data, size, p->dir, out) != MODBUS_ASCII_OK) {
+    if (modbus_ascii_decode(data, size, MODBUS_ASCII__RX(p->dir), out) != MODBUS_ASCII_OK) {
         return 0u;
     }
     p->frames++;
@@ -2688,8 +2767,13 @@ size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *da
 {
     size_t i;
     *got = false;
+#if MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_BOTH
+    if (!MODBUS_ASCII__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if MODBUS_ASCII__HEADERS
+#if MODBUS_ASCII__HEADERS && MODBUS_ASCII_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = modbus_ascii__whole(parser, data + i, len - i, out);
             if (size > 0u) {

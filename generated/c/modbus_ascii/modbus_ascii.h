@@ -28,6 +28,31 @@ extern "C" {
 #define MODBUS_ASCII_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. MODBUS_ASCII_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); MODBUS_ASCII_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * MODBUS_ASCII_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (MODBUS_ASCII_E_ARG). */
+#define MODBUS_ASCII_ROLE_HOST 1
+#define MODBUS_ASCII_ROLE_DEVICE 2
+#define MODBUS_ASCII_ROLE_BOTH 3
+#ifndef MODBUS_ASCII_ROLE
+#define MODBUS_ASCII_ROLE MODBUS_ASCII_ROLE_BOTH
+#endif
+#if MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_HOST && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_DEVICE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_BOTH
+#error "MODBUS_ASCII_ROLE must be MODBUS_ASCII_ROLE_HOST, MODBUS_ASCII_ROLE_DEVICE or MODBUS_ASCII_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define MODBUS_ASCII_ENCODES_REQUESTS (MODBUS_ASCII_ENABLE_ENCODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_DEVICE)
+#define MODBUS_ASCII_ENCODES_RESPONSES (MODBUS_ASCII_ENABLE_ENCODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_HOST)
+#define MODBUS_ASCII_DECODES_REQUESTS (MODBUS_ASCII_ENABLE_DECODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_HOST)
+#define MODBUS_ASCII_DECODES_RESPONSES (MODBUS_ASCII_ENABLE_DECODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef MODBUS_ASCII_PARSER_WHOLE_FRAMES
+#define MODBUS_ASCII_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 1073741824 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef MODBUS_ASCII_MAX_FRAME

@@ -25,6 +25,16 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
 #define MODBUS_RTU__SINGLE 1 /* one layout per direction */
 #define MODBUS_RTU__TABLES (MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (MODBUS_RTU_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define MODBUS_RTU__DECODES(dir) ((dir) == MODBUS_RTU_REQUEST ? MODBUS_RTU_DECODES_REQUESTS : (dir) == MODBUS_RTU_RESPONSE && MODBUS_RTU_DECODES_RESPONSES)
+#if MODBUS_RTU_DECODES_REQUESTS && !MODBUS_RTU_DECODES_RESPONSES
+#define MODBUS_RTU__RX(dir) MODBUS_RTU_REQUEST
+#elif MODBUS_RTU_DECODES_RESPONSES && !MODBUS_RTU_DECODES_REQUESTS
+#define MODBUS_RTU__RX(dir) MODBUS_RTU_RESPONSE
+#else
+#define MODBUS_RTU__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffff, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -230,7 +240,10 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1608,6 +1621,9 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
         return MODBUS_RTU_E_ARG;
     }
     out->kind = MODBUS_RTU_KIND_NONE;
+    if (!MODBUS_RTU__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return MODBUS_RTU_E_ARG;
+    }
     count = modbus_rtu__count(dir);
     if (count == 0u) {
         return MODBUS_RTU_E_ARG;
@@ -2203,6 +2219,7 @@ int modbus_rtu_encode_read_coils_request(const modbus_rtu_read_coils_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 1UL, values, m, modbus_rtu__enc_read_coils_request, buf, cap, len);
@@ -2214,6 +2231,7 @@ int modbus_rtu_encode_read_coils_response(const modbus_rtu_read_coils_response_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 1UL, values, m, modbus_rtu__enc_read_coils_response, buf, cap, len);
@@ -2225,6 +2243,7 @@ int modbus_rtu_encode_read_discrete_inputs_request(const modbus_rtu_read_discret
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 2UL, values, m, modbus_rtu__enc_read_discrete_inputs_request, buf, cap, len);
@@ -2236,6 +2255,7 @@ int modbus_rtu_encode_read_discrete_inputs_response(const modbus_rtu_read_discre
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 2UL, values, m, modbus_rtu__enc_read_discrete_inputs_response, buf, cap, len);
@@ -2247,6 +2267,7 @@ int modbus_rtu_encode_read_holding_registers_request(const modbus_rtu_read_holdi
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 3UL, values, m, modbus_rtu__enc_read_holding_registers_request, buf, cap, len);
@@ -2258,6 +2279,7 @@ int modbus_rtu_encode_read_holding_registers_response(const modbus_rtu_read_hold
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 3UL, values, m, modbus_rtu__enc_read_holding_registers_response, buf, cap, len);
@@ -2269,6 +2291,7 @@ int modbus_rtu_encode_read_input_registers_request(const modbus_rtu_read_input_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 4UL, values, m, modbus_rtu__enc_read_input_registers_request, buf, cap, len);
@@ -2280,6 +2303,7 @@ int modbus_rtu_encode_read_input_registers_response(const modbus_rtu_read_input_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 4UL, values, m, modbus_rtu__enc_read_input_registers_response, buf, cap, len);
@@ -2291,6 +2315,7 @@ int modbus_rtu_encode_write_coil_request(const modbus_rtu_write_coil_request_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 5UL, values, m, modbus_rtu__enc_write_coil_request, buf, cap, len);
@@ -2302,6 +2327,7 @@ int modbus_rtu_encode_write_coil_response(const modbus_rtu_write_coil_response_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 5UL, values, m, modbus_rtu__enc_write_coil_response, buf, cap, len);
@@ -2313,6 +2339,7 @@ int modbus_rtu_encode_write_register_request(const modbus_rtu_write_register_req
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 6UL, values, m, modbus_rtu__enc_write_register_request, buf, cap, len);
@@ -2324,6 +2351,7 @@ int modbus_rtu_encode_write_register_response(const modbus_rtu_write_register_re
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 6UL, values, m, modbus_rtu__enc_write_register_response, buf, cap, len);
@@ -2335,6 +2363,7 @@ int modbus_rtu_encode_write_coils_request(const modbus_rtu_write_coils_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 15UL, values, m, modbus_rtu__enc_write_coils_request, buf, cap, len);
@@ -2346,6 +2375,7 @@ int modbus_rtu_encode_write_coils_response(const modbus_rtu_write_coils_response
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 15UL, values, m, modbus_rtu__enc_write_coils_response, buf, cap, len);
@@ -2357,6 +2387,7 @@ int modbus_rtu_encode_write_registers_request(const modbus_rtu_write_registers_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 16UL, values, m, modbus_rtu__enc_write_registers_request, buf, cap, len);
@@ -2368,6 +2399,7 @@ int modbus_rtu_encode_write_registers_response(const modbus_rtu_write_registers_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 16UL, values, m, modbus_rtu__enc_write_registers_response, buf, cap, len);
@@ -2379,6 +2411,7 @@ int modbus_rtu_encode_mask_write_register_request(const modbus_rtu_mask_write_re
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 22UL, values, m, modbus_rtu__enc_mask_write_register_request, buf, cap, len);
@@ -2390,6 +2423,7 @@ int modbus_rtu_encode_mask_write_register_response(const modbus_rtu_mask_write_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 22UL, values, m, modbus_rtu__enc_mask_write_register_response, buf, cap, len);
@@ -2401,6 +2435,7 @@ int modbus_rtu_encode_read_write_registers_request(const modbus_rtu_read_write_r
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_REQUESTS) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_REQUEST, 23UL, values, m, modbus_rtu__enc_read_write_registers_request, buf, cap, len);
@@ -2412,6 +2447,7 @@ int modbus_rtu_encode_read_write_registers_response(const modbus_rtu_read_write_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
     return modbus_rtu__frame(MODBUS_RTU_RESPONSE, 23UL, values, m, modbus_rtu__enc_read_write_registers_response, buf, cap, len);
@@ -2423,6 +2459,7 @@ int modbus_rtu_encode_exception_response(const modbus_rtu_exception_response_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return MODBUS_RTU_E_ARG; }
     *len = 0u;
+    if (!MODBUS_RTU_ENCODES_RESPONSES) { return MODBUS_RTU_E_ARG; } /* left out of this build */
     if ((m->function & 128u) != 0u) { return MODBUS_RTU_E_RANGE; }
     if ((m->unit < 1u || m->unit > 247u) && m->unit != 0u) { return MODBUS_RTU_E_RANGE; } /* unit */
     values[0] = (uint32_t)m->unit;
@@ -2436,48 +2473,90 @@ int modbus_rtu_encode(const modbus_rtu_msg_t *msg, uint8_t *buf, size_t cap, siz
     }
     *len = 0u;
     switch (msg->kind) {
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_READ_COILS_REQUEST:
         return modbus_rtu_encode_read_coils_request(&msg->u.read_coils_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_READ_COILS_RESPONSE:
         return modbus_rtu_encode_read_coils_response(&msg->u.read_coils_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_READ_DISCRETE_INPUTS_REQUEST:
         return modbus_rtu_encode_read_discrete_inputs_request(&msg->u.read_discrete_inputs_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_READ_DISCRETE_INPUTS_RESPONSE:
         return modbus_rtu_encode_read_discrete_inputs_response(&msg->u.read_discrete_inputs_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_READ_HOLDING_REGISTERS_REQUEST:
         return modbus_rtu_encode_read_holding_registers_request(&msg->u.read_holding_registers_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_READ_HOLDING_REGISTERS_RESPONSE:
         return modbus_rtu_encode_read_holding_registers_response(&msg->u.read_holding_registers_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_READ_INPUT_REGISTERS_REQUEST:
         return modbus_rtu_encode_read_input_registers_request(&msg->u.read_input_registers_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_READ_INPUT_REGISTERS_RESPONSE:
         return modbus_rtu_encode_read_input_registers_response(&msg->u.read_input_registers_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_WRITE_COIL_REQUEST:
         return modbus_rtu_encode_write_coil_request(&msg->u.write_coil_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_WRITE_COIL_RESPONSE:
         return modbus_rtu_encode_write_coil_response(&msg->u.write_coil_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_WRITE_REGISTER_REQUEST:
         return modbus_rtu_encode_write_register_request(&msg->u.write_register_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_WRITE_REGISTER_RESPONSE:
         return modbus_rtu_encode_write_register_response(&msg->u.write_register_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_WRITE_COILS_REQUEST:
         return modbus_rtu_encode_write_coils_request(&msg->u.write_coils_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_WRITE_COILS_RESPONSE:
         return modbus_rtu_encode_write_coils_response(&msg->u.write_coils_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_WRITE_REGISTERS_REQUEST:
         return modbus_rtu_encode_write_registers_request(&msg->u.write_registers_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_WRITE_REGISTERS_RESPONSE:
         return modbus_rtu_encode_write_registers_response(&msg->u.write_registers_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_MASK_WRITE_REGISTER_REQUEST:
         return modbus_rtu_encode_mask_write_register_request(&msg->u.mask_write_register_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_MASK_WRITE_REGISTER_RESPONSE:
         return modbus_rtu_encode_mask_write_register_response(&msg->u.mask_write_register_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_REQUESTS
     case MODBUS_RTU_READ_WRITE_REGISTERS_REQUEST:
         return modbus_rtu_encode_read_write_registers_request(&msg->u.read_write_registers_request, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_READ_WRITE_REGISTERS_RESPONSE:
         return modbus_rtu_encode_read_write_registers_response(&msg->u.read_write_registers_response, buf, cap, len);
+#endif
+#if MODBUS_RTU_ENCODES_RESPONSES
     case MODBUS_RTU_EXCEPTION_RESPONSE:
         return modbus_rtu_encode_exception_response(&msg->u.exception_response, buf, cap, len);
+#endif
     default:
         return MODBUS_RTU_E_ARG;
     }
@@ -2502,13 +2581,13 @@ void modbus_rtu_parser_init(modbus_rtu_parser_t *parser, modbus_rtu_direction_t 
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t *out, size_t *size)
 {
-    uint8_t count = modbus_rtu__count(p->dir), k;
+    uint8_t count = modbus_rtu__count(MODBUS_RTU__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = modbus_rtu__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = modbus_rtu__probe_at(MODBUS_RTU__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == MODBUS_RTU__WAIT) {
             need = 0u;
             continue;
@@ -2522,7 +2601,7 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
             }
             continue;
         }
-        if (modbus_rtu_decode(p->buf + pos, (size_t)s, p->dir, out) != MODBUS_RTU_OK) {
+        if (modbus_rtu_decode(p->buf + pos, (size_t)s, MODBUS_RTU__RX(p->dir), out) != MODBUS_RTU_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_RTU__V_CORRUPT;
             }
@@ -2543,7 +2622,7 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
 static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
 {
 #if MODBUS_RTU__HEADERS
-    uint8_t count = modbus_rtu__count(p->dir), k;
+    uint8_t count = modbus_rtu__count(MODBUS_RTU__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2552,7 +2631,7 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = modbus_rtu__header(p->dir, k, &hl);
+            const uint8_t *h = modbus_rtu__header(MODBUS_RTU__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (modbus_rtu__same(p->buf + pos, h, hl)) {
@@ -2590,10 +2669,10 @@ static void modbus_rtu__drop(modbus_rtu_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int modbus_rtu__ends_header(const modbus_rtu_parser_t *p)
 {
-    uint8_t count = modbus_rtu__count(p->dir), k;
+    uint8_t count = modbus_rtu__count(MODBUS_RTU__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = modbus_rtu__header(p->dir, k, &hl);
+        const uint8_t *h = modbus_rtu__header(MODBUS_RTU__RX(p->dir), k, &hl);
         if (hl <= p->n && modbus_rtu__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2675,7 +2754,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     return got;
 }
 
-#if MODBUS_RTU__HEADERS
+#if MODBUS_RTU__HEADERS && MODBUS_RTU_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through modbus_rtu__push. */
@@ -2684,14 +2763,14 @@ static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, siz
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!MODBUS_RTU__SINGLE && modbus_rtu__count(p->dir) != 1u) {
+    if (!MODBUS_RTU__SINGLE && modbus_rtu__count(MODBUS_RTU__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = modbus_rtu__header(p->dir, 0u, &hl);
+    h = modbus_rtu__header(MODBUS_RTU__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !modbus_rtu__same(data, h, hl)) {
         return 0u;
     }
-    s = modbus_rtu__probe_at(p->dir, 0u, data, len);
+    s = modbus_rtu__probe_at(MODBUS_RTU__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > MODBUS_RTU_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2701,7 +2780,7 @@ static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, siz
             return 0u;
         }
     }
-    if (modbus_rtu_decode(data, size, p->dir, out) != MODBUS_RTU_OK) {
+    if (modbus_rtu_decode(data, size, MODBUS_RTU__RX(p->dir), out) != MODBUS_RTU_OK) {
         return 0u;
     }
     p->frames++;
@@ -2713,8 +2792,13 @@ size_t modbus_rtu_parser_feed(modbus_rtu_parser_t *parser, const uint8_t *data, 
 {
     size_t i;
     *got = false;
+#if MODBUS_RTU_ROLE != MODBUS_RTU_ROLE_BOTH
+    if (!MODBUS_RTU__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if MODBUS_RTU__HEADERS
+#if MODBUS_RTU__HEADERS && MODBUS_RTU_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = modbus_rtu__whole(parser, data + i, len - i, out);
             if (size > 0u) {

@@ -10,6 +10,8 @@
 #if NMEA0183_ENABLE_PARSER && !NMEA0183_ENABLE_DECODE
 #error "NMEA0183_ENABLE_PARSER needs NMEA0183_ENABLE_DECODE"
 #endif
+/* The directions the build decodes (NMEA0183_ROLE): the other side's is refused. */
+#define NMEA0183__DECODES(dir) ((dir) == NMEA0183_REQUEST ? NMEA0183_DECODES_REQUESTS : (dir) == NMEA0183_RESPONSE && NMEA0183_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says (`$`, the talker id and the sentence id (GPGGA), each field after a comma, then `*` and the XOR of every character between `$` and `*` as two upper-case hex digits, then CR LF; at most 82 characters (gpsd: "NMEA Revealed"). NMEA 0183 makes the checksum optional for some sentences, so a sentence without one is accepted unchecked.) ---- */
 #define NMEA0183__START 0x24u            /* '$' */
@@ -1114,6 +1116,9 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         return NMEA0183_E_ARG;
     }
     out->kind = NMEA0183_KIND_NONE;
+    if (!NMEA0183__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return NMEA0183_E_ARG;
+    }
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
@@ -1807,18 +1812,33 @@ static int nmea0183__body(const nmea0183_msg_t *msg, nmea0183__out_t *o, int che
     }}
     switch (msg->kind) {
     case NMEA0183_GGA_RESPONSE:
+        if (check && !NMEA0183_ENCODES_RESPONSES) {
+            return NMEA0183_E_ARG; /* left out */
+        }
         nmea0183__put_text(o, "GGA", 3u);
         return nmea0183__enc_gga_response(&msg->u.gga_response, o, check);
     case NMEA0183_RMC_RESPONSE:
+        if (check && !NMEA0183_ENCODES_RESPONSES) {
+            return NMEA0183_E_ARG; /* left out */
+        }
         nmea0183__put_text(o, "RMC", 3u);
         return nmea0183__enc_rmc_response(&msg->u.rmc_response, o, check);
     case NMEA0183_VTG_RESPONSE:
+        if (check && !NMEA0183_ENCODES_RESPONSES) {
+            return NMEA0183_E_ARG; /* left out */
+        }
         nmea0183__put_text(o, "VTG", 3u);
         return nmea0183__enc_vtg_response(&msg->u.vtg_response, o, check);
     case NMEA0183_GSA_RESPONSE:
+        if (check && !NMEA0183_ENCODES_RESPONSES) {
+            return NMEA0183_E_ARG; /* left out */
+        }
         nmea0183__put_text(o, "GSA", 3u);
         return nmea0183__enc_gsa_response(&msg->u.gsa_response, o, check);
     case NMEA0183_GSV_RESPONSE:
+        if (check && !NMEA0183_ENCODES_RESPONSES) {
+            return NMEA0183_E_ARG; /* left out */
+        }
         nmea0183__put_text(o, "GSV", 3u);
         return nmea0183__enc_gsv_response(&msg->u.gsv_response, o, check);
     case NMEA0183_KIND_NONE:
@@ -1933,6 +1953,11 @@ size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size
 {
     size_t i;
     *got = false;
+#if NMEA0183_ROLE != NMEA0183_ROLE_BOTH
+    if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
         if (nmea0183__push(parser, data[i], out)) {
             *got = true;

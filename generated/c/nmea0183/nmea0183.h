@@ -27,6 +27,25 @@ extern "C" {
 #define NMEA0183_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. NMEA0183_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); NMEA0183_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * NMEA0183_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (NMEA0183_E_ARG). */
+#define NMEA0183_ROLE_HOST 1
+#define NMEA0183_ROLE_DEVICE 2
+#define NMEA0183_ROLE_BOTH 3
+#ifndef NMEA0183_ROLE
+#define NMEA0183_ROLE NMEA0183_ROLE_BOTH
+#endif
+#if NMEA0183_ROLE != NMEA0183_ROLE_HOST && NMEA0183_ROLE != NMEA0183_ROLE_DEVICE && NMEA0183_ROLE != NMEA0183_ROLE_BOTH
+#error "NMEA0183_ROLE must be NMEA0183_ROLE_HOST, NMEA0183_ROLE_DEVICE or NMEA0183_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define NMEA0183_ENCODES_REQUESTS (NMEA0183_ENABLE_ENCODE && NMEA0183_ROLE != NMEA0183_ROLE_DEVICE)
+#define NMEA0183_ENCODES_RESPONSES (NMEA0183_ENABLE_ENCODE && NMEA0183_ROLE != NMEA0183_ROLE_HOST)
+#define NMEA0183_DECODES_REQUESTS (NMEA0183_ENABLE_DECODE && NMEA0183_ROLE != NMEA0183_ROLE_HOST)
+#define NMEA0183_DECODES_RESPONSES (NMEA0183_ENABLE_DECODE && NMEA0183_ROLE != NMEA0183_ROLE_DEVICE)
+
 /* The longest frame p_decode takes (NMEA0183_E_CAPACITY beyond): by default the longest the stream parser gives, the
  * spec's max_length (82 characters), the line ending and one more (as runtime/text.py's parser). */
 #ifndef NMEA0183_MAX_FRAME

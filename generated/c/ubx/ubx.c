@@ -25,6 +25,16 @@ typedef char ubx__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define UBX__LENGTHS 1 /* every layout has a length element */
 #define UBX__SINGLE 1 /* one layout per direction */
 #define UBX__TABLES (UBX_ENABLE_ENCODE || UBX__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (UBX_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define UBX__DECODES(dir) ((dir) == UBX_REQUEST ? UBX_DECODES_REQUESTS : (dir) == UBX_RESPONSE && UBX_DECODES_RESPONSES)
+#if UBX_DECODES_REQUESTS && !UBX_DECODES_RESPONSES
+#define UBX__RX(dir) UBX_REQUEST
+#elif UBX_DECODES_RESPONSES && !UBX_DECODES_REQUESTS
+#define UBX__RX(dir) UBX_RESPONSE
+#else
+#define UBX__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* Fletcher modulo 256: CK_A the sum of the bytes, CK_B the sum of CK_A after each byte; the value is
@@ -228,7 +238,10 @@ static int ubx__rewrite(const ubx__layout_t *L, int to_wire, const uint8_t *src,
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1538,6 +1551,9 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
         return UBX_E_ARG;
     }
     out->kind = UBX_KIND_NONE;
+    if (!UBX__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return UBX_E_ARG;
+    }
     count = ubx__count(dir);
     if (count == 0u) {
         return UBX_E_ARG;
@@ -2043,6 +2059,7 @@ int ubx_encode_nav_status_request(const ubx_nav_status_request_t *m, uint8_t *bu
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 259UL, values, m, ubx__enc_nav_status_request, buf, cap, len);
 }
@@ -2053,6 +2070,7 @@ int ubx_encode_nav_status_response(const ubx_nav_status_response_t *m, uint8_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 259UL, values, m, ubx__enc_nav_status_response, buf, cap, len);
 }
@@ -2063,6 +2081,7 @@ int ubx_encode_nav_pvt_request(const ubx_nav_pvt_request_t *m, uint8_t *buf, siz
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 263UL, values, m, ubx__enc_nav_pvt_request, buf, cap, len);
 }
@@ -2073,6 +2092,7 @@ int ubx_encode_nav_pvt_response(const ubx_nav_pvt_response_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 263UL, values, m, ubx__enc_nav_pvt_response, buf, cap, len);
 }
@@ -2083,6 +2103,7 @@ int ubx_encode_ack_nak_response(const ubx_ack_nak_response_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 1280UL, values, m, ubx__enc_ack_nak_response, buf, cap, len);
 }
@@ -2093,6 +2114,7 @@ int ubx_encode_ack_ack_response(const ubx_ack_ack_response_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 1281UL, values, m, ubx__enc_ack_ack_response, buf, cap, len);
 }
@@ -2103,6 +2125,7 @@ int ubx_encode_cfg_rate_request(const ubx_cfg_rate_request_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 1544UL, values, m, ubx__enc_cfg_rate_request, buf, cap, len);
 }
@@ -2113,6 +2136,7 @@ int ubx_encode_cfg_rate_response(const ubx_cfg_rate_response_t *m, uint8_t *buf,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 1544UL, values, m, ubx__enc_cfg_rate_response, buf, cap, len);
 }
@@ -2123,6 +2147,7 @@ int ubx_encode_set_rate_request(const ubx_set_rate_request_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 1544UL, values, m, ubx__enc_set_rate_request, buf, cap, len);
 }
@@ -2133,6 +2158,7 @@ int ubx_encode_cfg_valset_request(const ubx_cfg_valset_request_t *m, uint8_t *bu
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 1674UL, values, m, ubx__enc_cfg_valset_request, buf, cap, len);
 }
@@ -2143,6 +2169,7 @@ int ubx_encode_cfg_valget_request(const ubx_cfg_valget_request_t *m, uint8_t *bu
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 1675UL, values, m, ubx__enc_cfg_valget_request, buf, cap, len);
 }
@@ -2153,6 +2180,7 @@ int ubx_encode_cfg_valget_response(const ubx_cfg_valget_response_t *m, uint8_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 1675UL, values, m, ubx__enc_cfg_valget_response, buf, cap, len);
 }
@@ -2163,6 +2191,7 @@ int ubx_encode_mon_ver_request(const ubx_mon_ver_request_t *m, uint8_t *buf, siz
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_REQUESTS) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_REQUEST, 2564UL, values, m, ubx__enc_mon_ver_request, buf, cap, len);
 }
@@ -2173,6 +2202,7 @@ int ubx_encode_mon_ver_response(const ubx_mon_ver_response_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return UBX_E_ARG; }
     *len = 0u;
+    if (!UBX_ENCODES_RESPONSES) { return UBX_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return ubx__frame(UBX_RESPONSE, 2564UL, values, m, ubx__enc_mon_ver_response, buf, cap, len);
 }
@@ -2184,34 +2214,62 @@ int ubx_encode(const ubx_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     }
     *len = 0u;
     switch (msg->kind) {
+#if UBX_ENCODES_REQUESTS
     case UBX_NAV_STATUS_REQUEST:
         return ubx_encode_nav_status_request(&msg->u.nav_status_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_NAV_STATUS_RESPONSE:
         return ubx_encode_nav_status_response(&msg->u.nav_status_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_NAV_PVT_REQUEST:
         return ubx_encode_nav_pvt_request(&msg->u.nav_pvt_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_NAV_PVT_RESPONSE:
         return ubx_encode_nav_pvt_response(&msg->u.nav_pvt_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_ACK_NAK_RESPONSE:
         return ubx_encode_ack_nak_response(&msg->u.ack_nak_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_ACK_ACK_RESPONSE:
         return ubx_encode_ack_ack_response(&msg->u.ack_ack_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_CFG_RATE_REQUEST:
         return ubx_encode_cfg_rate_request(&msg->u.cfg_rate_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_CFG_RATE_RESPONSE:
         return ubx_encode_cfg_rate_response(&msg->u.cfg_rate_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_SET_RATE_REQUEST:
         return ubx_encode_set_rate_request(&msg->u.set_rate_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_CFG_VALSET_REQUEST:
         return ubx_encode_cfg_valset_request(&msg->u.cfg_valset_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_CFG_VALGET_REQUEST:
         return ubx_encode_cfg_valget_request(&msg->u.cfg_valget_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_CFG_VALGET_RESPONSE:
         return ubx_encode_cfg_valget_response(&msg->u.cfg_valget_response, buf, cap, len);
+#endif
+#if UBX_ENCODES_REQUESTS
     case UBX_MON_VER_REQUEST:
         return ubx_encode_mon_ver_request(&msg->u.mon_ver_request, buf, cap, len);
+#endif
+#if UBX_ENCODES_RESPONSES
     case UBX_MON_VER_RESPONSE:
         return ubx_encode_mon_ver_response(&msg->u.mon_ver_response, buf, cap, len);
+#endif
     default:
         return UBX_E_ARG;
     }
@@ -2236,13 +2294,13 @@ void ubx_parser_init(ubx_parser_t *parser, ubx_direction_t dir)
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
 {
-    uint8_t count = ubx__count(p->dir), k;
+    uint8_t count = ubx__count(UBX__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = ubx__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = ubx__probe_at(UBX__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == UBX__WAIT) {
             need = 0u;
             continue;
@@ -2256,7 +2314,7 @@ static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
             }
             continue;
         }
-        if (ubx_decode(p->buf + pos, (size_t)s, p->dir, out) != UBX_OK) {
+        if (ubx_decode(p->buf + pos, (size_t)s, UBX__RX(p->dir), out) != UBX_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = UBX__V_CORRUPT;
             }
@@ -2277,7 +2335,7 @@ static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
 static size_t ubx__next(ubx_parser_t *p, size_t start)
 {
 #if UBX__HEADERS
-    uint8_t count = ubx__count(p->dir), k;
+    uint8_t count = ubx__count(UBX__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2286,7 +2344,7 @@ static size_t ubx__next(ubx_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = ubx__header(p->dir, k, &hl);
+            const uint8_t *h = ubx__header(UBX__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (ubx__same(p->buf + pos, h, hl)) {
@@ -2324,10 +2382,10 @@ static void ubx__drop(ubx_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int ubx__ends_header(const ubx_parser_t *p)
 {
-    uint8_t count = ubx__count(p->dir), k;
+    uint8_t count = ubx__count(UBX__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = ubx__header(p->dir, k, &hl);
+        const uint8_t *h = ubx__header(UBX__RX(p->dir), k, &hl);
         if (hl <= p->n && ubx__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2409,7 +2467,7 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
     return got;
 }
 
-#if UBX__HEADERS
+#if UBX__HEADERS && UBX_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through ubx__push. */
@@ -2418,14 +2476,14 @@ static size_t ubx__whole(ubx_parser_t *p, const uint8_t *data, size_t len, ubx_m
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!UBX__SINGLE && ubx__count(p->dir) != 1u) {
+    if (!UBX__SINGLE && ubx__count(UBX__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = ubx__header(p->dir, 0u, &hl);
+    h = ubx__header(UBX__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !ubx__same(data, h, hl)) {
         return 0u;
     }
-    s = ubx__probe_at(p->dir, 0u, data, len);
+    s = ubx__probe_at(UBX__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > UBX_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2435,7 +2493,7 @@ static size_t ubx__whole(ubx_parser_t *p, const uint8_t *data, size_t len, ubx_m
             return 0u;
         }
     }
-    if (ubx_decode(data, size, p->dir, out) != UBX_OK) {
+    if (ubx_decode(data, size, UBX__RX(p->dir), out) != UBX_OK) {
         return 0u;
     }
     p->frames++;
@@ -2447,8 +2505,13 @@ size_t ubx_parser_feed(ubx_parser_t *parser, const uint8_t *data, size_t len, ub
 {
     size_t i;
     *got = false;
+#if UBX_ROLE != UBX_ROLE_BOTH
+    if (!UBX__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if UBX__HEADERS
+#if UBX__HEADERS && UBX_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = ubx__whole(parser, data + i, len - i, out);
             if (size > 0u) {

@@ -28,6 +28,31 @@ extern "C" {
 #define UBX_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. UBX_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); UBX_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * UBX_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (UBX_E_ARG). */
+#define UBX_ROLE_HOST 1
+#define UBX_ROLE_DEVICE 2
+#define UBX_ROLE_BOTH 3
+#ifndef UBX_ROLE
+#define UBX_ROLE UBX_ROLE_BOTH
+#endif
+#if UBX_ROLE != UBX_ROLE_HOST && UBX_ROLE != UBX_ROLE_DEVICE && UBX_ROLE != UBX_ROLE_BOTH
+#error "UBX_ROLE must be UBX_ROLE_HOST, UBX_ROLE_DEVICE or UBX_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define UBX_ENCODES_REQUESTS (UBX_ENABLE_ENCODE && UBX_ROLE != UBX_ROLE_DEVICE)
+#define UBX_ENCODES_RESPONSES (UBX_ENABLE_ENCODE && UBX_ROLE != UBX_ROLE_HOST)
+#define UBX_DECODES_REQUESTS (UBX_ENABLE_DECODE && UBX_ROLE != UBX_ROLE_HOST)
+#define UBX_DECODES_RESPONSES (UBX_ENABLE_DECODE && UBX_ROLE != UBX_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef UBX_PARSER_WHOLE_FRAMES
+#define UBX_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65543 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef UBX_MAX_FRAME

@@ -25,6 +25,16 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__LENGTHS 1 /* every layout has a length element */
 #define VESC__SINGLE 0 /* one layout per direction */
 #define VESC__TABLES (VESC_ENABLE_ENCODE || VESC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
+/* The directions the build decodes (VESC_ROLE): the other side's is refused before any work, so the compiler leaves
+ * its code out; the parser's direction is a constant where the build decodes one. */
+#define VESC__DECODES(dir) ((dir) == VESC_REQUEST ? VESC_DECODES_REQUESTS : (dir) == VESC_RESPONSE && VESC_DECODES_RESPONSES)
+#if VESC_DECODES_REQUESTS && !VESC_DECODES_RESPONSES
+#define VESC__RX(dir) VESC_REQUEST
+#elif VESC_DECODES_RESPONSES && !VESC_DECODES_REQUESTS
+#define VESC__RX(dir) VESC_RESPONSE
+#else
+#define VESC__RX(dir) (dir)
+#endif
 
 /* ---- checksums ---- */
 /* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -230,7 +240,10 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1589,6 +1602,9 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
         return VESC_E_ARG;
     }
     out->kind = VESC_KIND_NONE;
+    if (!VESC__DECODES(dir)) { /* the other side's direction, left out of this build */
+        return VESC_E_ARG;
+    }
     count = vesc__count(dir);
     if (count == 0u) {
         return VESC_E_ARG;
@@ -2017,6 +2033,7 @@ int vesc_encode_fw_version_request(const vesc_fw_version_request_t *m, uint8_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 0UL, values, m, vesc__enc_fw_version_request, buf, cap, len);
 }
@@ -2027,6 +2044,7 @@ int vesc_encode_fw_version_response(const vesc_fw_version_response_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_RESPONSES) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_RESPONSE, 0UL, values, m, vesc__enc_fw_version_response, buf, cap, len);
 }
@@ -2037,6 +2055,7 @@ int vesc_encode_get_values_request(const vesc_get_values_request_t *m, uint8_t *
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 4UL, values, m, vesc__enc_get_values_request, buf, cap, len);
 }
@@ -2047,6 +2066,7 @@ int vesc_encode_get_values_response(const vesc_get_values_response_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_RESPONSES) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_RESPONSE, 4UL, values, m, vesc__enc_get_values_response, buf, cap, len);
 }
@@ -2057,6 +2077,7 @@ int vesc_encode_set_duty_request(const vesc_set_duty_request_t *m, uint8_t *buf,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 5UL, values, m, vesc__enc_set_duty_request, buf, cap, len);
 }
@@ -2067,6 +2088,7 @@ int vesc_encode_set_current_request(const vesc_set_current_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 6UL, values, m, vesc__enc_set_current_request, buf, cap, len);
 }
@@ -2077,6 +2099,7 @@ int vesc_encode_set_current_brake_request(const vesc_set_current_brake_request_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 7UL, values, m, vesc__enc_set_current_brake_request, buf, cap, len);
 }
@@ -2087,6 +2110,7 @@ int vesc_encode_set_rpm_request(const vesc_set_rpm_request_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 8UL, values, m, vesc__enc_set_rpm_request, buf, cap, len);
 }
@@ -2097,6 +2121,7 @@ int vesc_encode_set_pos_request(const vesc_set_pos_request_t *m, uint8_t *buf, s
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 9UL, values, m, vesc__enc_set_pos_request, buf, cap, len);
 }
@@ -2107,6 +2132,7 @@ int vesc_encode_set_handbrake_request(const vesc_set_handbrake_request_t *m, uin
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 10UL, values, m, vesc__enc_set_handbrake_request, buf, cap, len);
 }
@@ -2117,6 +2143,7 @@ int vesc_encode_print_response(const vesc_print_response_t *m, uint8_t *buf, siz
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_RESPONSES) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_RESPONSE, 21UL, values, m, vesc__enc_print_response, buf, cap, len);
 }
@@ -2127,6 +2154,7 @@ int vesc_encode_rotor_position_response(const vesc_rotor_position_response_t *m,
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_RESPONSES) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_RESPONSE, 22UL, values, m, vesc__enc_rotor_position_response, buf, cap, len);
 }
@@ -2137,6 +2165,7 @@ int vesc_encode_alive_request(const vesc_alive_request_t *m, uint8_t *buf, size_
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 30UL, values, m, vesc__enc_alive_request, buf, cap, len);
 }
@@ -2147,6 +2176,7 @@ int vesc_encode_forward_can_request(const vesc_forward_can_request_t *m, uint8_t
     uint32_t values[1];
     if (m == NULL || buf == NULL || len == NULL) { return VESC_E_ARG; }
     *len = 0u;
+    if (!VESC_ENCODES_REQUESTS) { return VESC_E_ARG; } /* left out of this build */
     values[0] = 0u;
     return vesc__frame(VESC_REQUEST, 34UL, values, m, vesc__enc_forward_can_request, buf, cap, len);
 }
@@ -2158,34 +2188,62 @@ int vesc_encode(const vesc_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     }
     *len = 0u;
     switch (msg->kind) {
+#if VESC_ENCODES_REQUESTS
     case VESC_FW_VERSION_REQUEST:
         return vesc_encode_fw_version_request(&msg->u.fw_version_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_RESPONSES
     case VESC_FW_VERSION_RESPONSE:
         return vesc_encode_fw_version_response(&msg->u.fw_version_response, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_GET_VALUES_REQUEST:
         return vesc_encode_get_values_request(&msg->u.get_values_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_RESPONSES
     case VESC_GET_VALUES_RESPONSE:
         return vesc_encode_get_values_response(&msg->u.get_values_response, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_DUTY_REQUEST:
         return vesc_encode_set_duty_request(&msg->u.set_duty_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_CURRENT_REQUEST:
         return vesc_encode_set_current_request(&msg->u.set_current_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_CURRENT_BRAKE_REQUEST:
         return vesc_encode_set_current_brake_request(&msg->u.set_current_brake_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_RPM_REQUEST:
         return vesc_encode_set_rpm_request(&msg->u.set_rpm_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_POS_REQUEST:
         return vesc_encode_set_pos_request(&msg->u.set_pos_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_SET_HANDBRAKE_REQUEST:
         return vesc_encode_set_handbrake_request(&msg->u.set_handbrake_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_RESPONSES
     case VESC_PRINT_RESPONSE:
         return vesc_encode_print_response(&msg->u.print_response, buf, cap, len);
+#endif
+#if VESC_ENCODES_RESPONSES
     case VESC_ROTOR_POSITION_RESPONSE:
         return vesc_encode_rotor_position_response(&msg->u.rotor_position_response, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_ALIVE_REQUEST:
         return vesc_encode_alive_request(&msg->u.alive_request, buf, cap, len);
+#endif
+#if VESC_ENCODES_REQUESTS
     case VESC_FORWARD_CAN_REQUEST:
         return vesc_encode_forward_can_request(&msg->u.forward_can_request, buf, cap, len);
+#endif
     default:
         return VESC_E_ARG;
     }
@@ -2210,13 +2268,13 @@ void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size)
 {
-    uint8_t count = vesc__count(p->dir), k;
+    uint8_t count = vesc__count(VESC__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
     for (k = 0u; k < count; k++) {
-        long s = vesc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = vesc__probe_at(VESC__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == VESC__WAIT) {
             need = 0u;
             continue;
@@ -2230,7 +2288,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
             }
             continue;
         }
-        if (vesc_decode(p->buf + pos, (size_t)s, p->dir, out) != VESC_OK) {
+        if (vesc_decode(p->buf + pos, (size_t)s, VESC__RX(p->dir), out) != VESC_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = VESC__V_CORRUPT;
             }
@@ -2251,7 +2309,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
 static size_t vesc__next(vesc_parser_t *p, size_t start)
 {
 #if VESC__HEADERS
-    uint8_t count = vesc__count(p->dir), k;
+    uint8_t count = vesc__count(VESC__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2260,7 +2318,7 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
         }
         for (k = 0u; k < count; k++) {
             size_t hl;
-            const uint8_t *h = vesc__header(p->dir, k, &hl);
+            const uint8_t *h = vesc__header(VESC__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {
                 whole = 0;
             } else if (vesc__same(p->buf + pos, h, hl)) {
@@ -2298,10 +2356,10 @@ static void vesc__drop(vesc_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int vesc__ends_header(const vesc_parser_t *p)
 {
-    uint8_t count = vesc__count(p->dir), k;
+    uint8_t count = vesc__count(VESC__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {
         size_t hl;
-        const uint8_t *h = vesc__header(p->dir, k, &hl);
+        const uint8_t *h = vesc__header(VESC__RX(p->dir), k, &hl);
         if (hl <= p->n && vesc__same(p->buf + p->n - hl, h, hl)) {
             return 1;
         }
@@ -2383,7 +2441,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     return got;
 }
 
-#if VESC__HEADERS
+#if VESC__HEADERS && VESC_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through vesc__push. */
@@ -2392,14 +2450,14 @@ static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, ves
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!VESC__SINGLE && vesc__count(p->dir) != 1u) {
+    if (!VESC__SINGLE && vesc__count(VESC__RX(p->dir)) != 1u) {
         return 0u;
     }
-    h = vesc__header(p->dir, 0u, &hl);
+    h = vesc__header(VESC__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !vesc__same(data, h, hl)) {
         return 0u;
     }
-    s = vesc__probe_at(p->dir, 0u, data, len);
+    s = vesc__probe_at(VESC__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > VESC_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
@@ -2409,7 +2467,7 @@ static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, ves
             return 0u;
         }
     }
-    if (vesc_decode(data, size, p->dir, out) != VESC_OK) {
+    if (vesc_decode(data, size, VESC__RX(p->dir), out) != VESC_OK) {
         return 0u;
     }
     p->frames++;
@@ -2421,8 +2479,13 @@ size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, 
 {
     size_t i;
     *got = false;
+#if VESC_ROLE != VESC_ROLE_BOTH
+    if (!VESC__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
-#if VESC__HEADERS
+#if VESC__HEADERS && VESC_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = vesc__whole(parser, data + i, len - i, out);
             if (size > 0u) {

@@ -28,6 +28,31 @@ extern "C" {
 #define VESC_ENABLE_PARSER 1
 #endif
 
+/* Which side of the link the build is for. VESC_ROLE_HOST sends requests and reads responses (a servo controller, a
+ * bus master, a client); VESC_ROLE_DEVICE reads requests and sends responses (the servo, the slave, the server);
+ * VESC_ROLE_BOTH (the default) does both. A build for one side leaves out the other side's decoders, encoders and
+ * parser code: decode and the parser refuse the other side's direction, encode its messages (VESC_E_ARG). */
+#define VESC_ROLE_HOST 1
+#define VESC_ROLE_DEVICE 2
+#define VESC_ROLE_BOTH 3
+#ifndef VESC_ROLE
+#define VESC_ROLE VESC_ROLE_BOTH
+#endif
+#if VESC_ROLE != VESC_ROLE_HOST && VESC_ROLE != VESC_ROLE_DEVICE && VESC_ROLE != VESC_ROLE_BOTH
+#error "VESC_ROLE must be VESC_ROLE_HOST, VESC_ROLE_DEVICE or VESC_ROLE_BOTH"
+#endif
+/* What the build keeps (1) or leaves out (0), from the role and the switches above. */
+#define VESC_ENCODES_REQUESTS (VESC_ENABLE_ENCODE && VESC_ROLE != VESC_ROLE_DEVICE)
+#define VESC_ENCODES_RESPONSES (VESC_ENABLE_ENCODE && VESC_ROLE != VESC_ROLE_HOST)
+#define VESC_DECODES_REQUESTS (VESC_ENABLE_DECODE && VESC_ROLE != VESC_ROLE_HOST)
+#define VESC_DECODES_RESPONSES (VESC_ENABLE_DECODE && VESC_ROLE != VESC_ROLE_DEVICE)
+
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef VESC_PARSER_WHOLE_FRAMES
+#define VESC_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65541 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef VESC_MAX_FRAME

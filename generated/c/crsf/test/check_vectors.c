@@ -23,14 +23,21 @@ int main(void)
     const crsf_vector_t *v;
     for (v = crsf_vectors; v->frame != NULL; v++) {
         crsf_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == CRSF_REQUEST ? CRSF_DECODES_REQUESTS : CRSF_DECODES_RESPONSES;
+        const int encodes = v->direction == CRSF_REQUEST ? CRSF_ENCODES_REQUESTS : CRSF_ENCODES_RESPONSES;
 #if CRSF_ENABLE_DECODE
         int result = crsf_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != CRSF_OK || msg.kind != v->kind) {
+        if (!decodes && result != CRSF_E_ARG) {
+            crsf__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != CRSF_OK || msg.kind != v->kind)) {
             crsf__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if CRSF_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[CRSF_MAX_FRAME];
             size_t len = 0;
             result = crsf_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if CRSF_ENABLE_PARSER
-        {
+        if (decodes) {
             crsf_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if CRSF_ENABLE_DECODE
     for (v = crsf_refused; v->frame != NULL; v++) {
         crsf_msg_t msg;
-        if (crsf_decode(v->frame, v->len, v->direction, &msg) == CRSF_OK)
+        if (crsf_decode(v->frame, v->len, v->direction, &msg) == CRSF_OK && (v->direction == CRSF_REQUEST ?
+                CRSF_DECODES_REQUESTS : CRSF_DECODES_RESPONSES))
             crsf__fail(&failed, v->name, "a frame the documents print wrong is accepted", CRSF_OK);
     }
 #endif

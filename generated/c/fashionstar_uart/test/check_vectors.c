@@ -23,14 +23,21 @@ int main(void)
     const fashionstar_uart_vector_t *v;
     for (v = fashionstar_uart_vectors; v->frame != NULL; v++) {
         fashionstar_uart_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == FASHIONSTAR_UART_REQUEST ? FASHIONSTAR_UART_DECODES_REQUESTS : FASHIONSTAR_UART_DECODES_RESPONSES;
+        const int encodes = v->direction == FASHIONSTAR_UART_REQUEST ? FASHIONSTAR_UART_ENCODES_REQUESTS : FASHIONSTAR_UART_ENCODES_RESPONSES;
 #if FASHIONSTAR_UART_ENABLE_DECODE
         int result = fashionstar_uart_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != FASHIONSTAR_UART_OK || msg.kind != v->kind) {
+        if (!decodes && result != FASHIONSTAR_UART_E_ARG) {
+            fashionstar_uart__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != FASHIONSTAR_UART_OK || msg.kind != v->kind)) {
             fashionstar_uart__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if FASHIONSTAR_UART_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[FASHIONSTAR_UART_MAX_FRAME];
             size_t len = 0;
             result = fashionstar_uart_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if FASHIONSTAR_UART_ENABLE_PARSER
-        {
+        if (decodes) {
             fashionstar_uart_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if FASHIONSTAR_UART_ENABLE_DECODE
     for (v = fashionstar_uart_refused; v->frame != NULL; v++) {
         fashionstar_uart_msg_t msg;
-        if (fashionstar_uart_decode(v->frame, v->len, v->direction, &msg) == FASHIONSTAR_UART_OK)
+        if (fashionstar_uart_decode(v->frame, v->len, v->direction, &msg) == FASHIONSTAR_UART_OK && (v->direction == FASHIONSTAR_UART_REQUEST ?
+                FASHIONSTAR_UART_DECODES_REQUESTS : FASHIONSTAR_UART_DECODES_RESPONSES))
             fashionstar_uart__fail(&failed, v->name, "a frame the documents print wrong is accepted", FASHIONSTAR_UART_OK);
     }
 #endif

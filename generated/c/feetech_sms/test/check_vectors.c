@@ -23,14 +23,21 @@ int main(void)
     const feetech_sms_vector_t *v;
     for (v = feetech_sms_vectors; v->frame != NULL; v++) {
         feetech_sms_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == FEETECH_SMS_REQUEST ? FEETECH_SMS_DECODES_REQUESTS : FEETECH_SMS_DECODES_RESPONSES;
+        const int encodes = v->direction == FEETECH_SMS_REQUEST ? FEETECH_SMS_ENCODES_REQUESTS : FEETECH_SMS_ENCODES_RESPONSES;
 #if FEETECH_SMS_ENABLE_DECODE
         int result = feetech_sms_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != FEETECH_SMS_OK || msg.kind != v->kind) {
+        if (!decodes && result != FEETECH_SMS_E_ARG) {
+            feetech_sms__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != FEETECH_SMS_OK || msg.kind != v->kind)) {
             feetech_sms__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if FEETECH_SMS_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[FEETECH_SMS_MAX_FRAME];
             size_t len = 0;
             result = feetech_sms_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if FEETECH_SMS_ENABLE_PARSER
-        {
+        if (decodes) {
             feetech_sms_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if FEETECH_SMS_ENABLE_DECODE
     for (v = feetech_sms_refused; v->frame != NULL; v++) {
         feetech_sms_msg_t msg;
-        if (feetech_sms_decode(v->frame, v->len, v->direction, &msg) == FEETECH_SMS_OK)
+        if (feetech_sms_decode(v->frame, v->len, v->direction, &msg) == FEETECH_SMS_OK && (v->direction == FEETECH_SMS_REQUEST ?
+                FEETECH_SMS_DECODES_REQUESTS : FEETECH_SMS_DECODES_RESPONSES))
             feetech_sms__fail(&failed, v->name, "a frame the documents print wrong is accepted", FEETECH_SMS_OK);
     }
 #endif

@@ -23,14 +23,21 @@ int main(void)
     const modbus_ascii_vector_t *v;
     for (v = modbus_ascii_vectors; v->frame != NULL; v++) {
         modbus_ascii_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == MODBUS_ASCII_REQUEST ? MODBUS_ASCII_DECODES_REQUESTS : MODBUS_ASCII_DECODES_RESPONSES;
+        const int encodes = v->direction == MODBUS_ASCII_REQUEST ? MODBUS_ASCII_ENCODES_REQUESTS : MODBUS_ASCII_ENCODES_RESPONSES;
 #if MODBUS_ASCII_ENABLE_DECODE
         int result = modbus_ascii_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != MODBUS_ASCII_OK || msg.kind != v->kind) {
+        if (!decodes && result != MODBUS_ASCII_E_ARG) {
+            modbus_ascii__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != MODBUS_ASCII_OK || msg.kind != v->kind)) {
             modbus_ascii__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if MODBUS_ASCII_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[MODBUS_ASCII_MAX_FRAME];
             size_t len = 0;
             result = modbus_ascii_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if MODBUS_ASCII_ENABLE_PARSER
-        {
+        if (decodes) {
             modbus_ascii_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if MODBUS_ASCII_ENABLE_DECODE
     for (v = modbus_ascii_refused; v->frame != NULL; v++) {
         modbus_ascii_msg_t msg;
-        if (modbus_ascii_decode(v->frame, v->len, v->direction, &msg) == MODBUS_ASCII_OK)
+        if (modbus_ascii_decode(v->frame, v->len, v->direction, &msg) == MODBUS_ASCII_OK && (v->direction == MODBUS_ASCII_REQUEST ?
+                MODBUS_ASCII_DECODES_REQUESTS : MODBUS_ASCII_DECODES_RESPONSES))
             modbus_ascii__fail(&failed, v->name, "a frame the documents print wrong is accepted", MODBUS_ASCII_OK);
     }
 #endif

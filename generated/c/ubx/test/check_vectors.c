@@ -23,14 +23,21 @@ int main(void)
     const ubx_vector_t *v;
     for (v = ubx_vectors; v->frame != NULL; v++) {
         ubx_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == UBX_REQUEST ? UBX_DECODES_REQUESTS : UBX_DECODES_RESPONSES;
+        const int encodes = v->direction == UBX_REQUEST ? UBX_ENCODES_REQUESTS : UBX_ENCODES_RESPONSES;
 #if UBX_ENABLE_DECODE
         int result = ubx_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != UBX_OK || msg.kind != v->kind) {
+        if (!decodes && result != UBX_E_ARG) {
+            ubx__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != UBX_OK || msg.kind != v->kind)) {
             ubx__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if UBX_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[UBX_MAX_FRAME];
             size_t len = 0;
             result = ubx_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if UBX_ENABLE_PARSER
-        {
+        if (decodes) {
             ubx_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if UBX_ENABLE_DECODE
     for (v = ubx_refused; v->frame != NULL; v++) {
         ubx_msg_t msg;
-        if (ubx_decode(v->frame, v->len, v->direction, &msg) == UBX_OK)
+        if (ubx_decode(v->frame, v->len, v->direction, &msg) == UBX_OK && (v->direction == UBX_REQUEST ?
+                UBX_DECODES_REQUESTS : UBX_DECODES_RESPONSES))
             ubx__fail(&failed, v->name, "a frame the documents print wrong is accepted", UBX_OK);
     }
 #endif

@@ -23,14 +23,21 @@ int main(void)
     const vesc_vector_t *v;
     for (v = vesc_vectors; v->frame != NULL; v++) {
         vesc_msg_t msg;
+        /* what the build keeps of this direction (its role: the other side's is refused) */
+        const int decodes = v->direction == VESC_REQUEST ? VESC_DECODES_REQUESTS : VESC_DECODES_RESPONSES;
+        const int encodes = v->direction == VESC_REQUEST ? VESC_ENCODES_REQUESTS : VESC_ENCODES_RESPONSES;
 #if VESC_ENABLE_DECODE
         int result = vesc_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);
-        if (result != VESC_OK || msg.kind != v->kind) {
+        if (!decodes && result != VESC_E_ARG) {
+            vesc__fail(&failed, v->name, "the other side's frame is not refused", result);
+            continue;
+        }
+        if (decodes && (result != VESC_OK || msg.kind != v->kind)) {
             vesc__fail(&failed, v->name, "decode", result);
             continue;
         }
 #if VESC_ENABLE_ENCODE
-        {
+        if (decodes && encodes) {
             uint8_t buf[VESC_MAX_FRAME];
             size_t len = 0;
             result = vesc_encode(&msg, buf, sizeof buf, &len);
@@ -40,7 +47,7 @@ int main(void)
 #endif
 #endif
 #if VESC_ENABLE_PARSER
-        {
+        if (decodes) {
             vesc_parser_t parser;
             size_t at = 0;
             bool got = false;
@@ -52,11 +59,14 @@ int main(void)
         }
 #endif
         (void)msg;
+        (void)decodes;
+        (void)encodes;
     }
 #if VESC_ENABLE_DECODE
     for (v = vesc_refused; v->frame != NULL; v++) {
         vesc_msg_t msg;
-        if (vesc_decode(v->frame, v->len, v->direction, &msg) == VESC_OK)
+        if (vesc_decode(v->frame, v->len, v->direction, &msg) == VESC_OK && (v->direction == VESC_REQUEST ?
+                VESC_DECODES_REQUESTS : VESC_DECODES_RESPONSES))
             vesc__fail(&failed, v->name, "a frame the documents print wrong is accepted", VESC_OK);
     }
 #endif

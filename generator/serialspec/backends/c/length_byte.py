@@ -312,6 +312,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     return 0;
 }}
 
+#if {P}_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
@@ -337,12 +338,14 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     p->frames++;
     return size;
 }}
+#endif
 
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
 {{
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {{
+#if {P}_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {{
             size_t size = {p}__whole(parser, data + i, len - i, out);
             if (size > 0u) {{
@@ -350,6 +353,7 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
                 return i + size;
             }}
         }}
+#endif
         if ({p}__push(parser, data[i], out)) {{
             *got = true;
             return i + 1u;

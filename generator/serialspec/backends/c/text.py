@@ -11,6 +11,7 @@ from typing import assert_never
 
 from serialspec.backends import Unsupported
 from serialspec.backends.c.emit import comment, ident, spec_hash
+from serialspec.backends.c.files import role_macros
 from serialspec.backends.c.text_runtime import TEXT_RUNTIME
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
@@ -144,7 +145,7 @@ extern "C" {{
 #ifndef {P}_ENABLE_PARSER
 #define {P}_ENABLE_PARSER 1
 #endif
-
+{role_macros(P)}
 /* The longest frame p_decode takes ({P}_E_CAPACITY beyond): by default the longest the stream parser gives, the
  * spec's max_length ({t.max_length} characters), the line ending and one more (as runtime/text.py's parser). */
 #ifndef {P}_MAX_FRAME
@@ -466,7 +467,10 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             for m in t.messages
         )
         enc_cases = "\n".join(
-            f"    case {P}_{mid(m).upper()}:\n        {p}__put_text(o, {c_text(m.code)}, {len(m.code)}u);\n"
+            f"    case {P}_{mid(m).upper()}:\n"
+            f"        if (check && !{P}_ENCODES_{m.direction.name}S) {{\n"
+            f"            return {P}_E_ARG; /* left out */\n        }}\n"
+            f"        {p}__put_text(o, {c_text(m.code)}, {len(m.code)}u);\n"
             f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
             for m in t.messages
         )
@@ -507,6 +511,8 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 #if {P}_ENABLE_PARSER && !{P}_ENABLE_DECODE
 #error "{P}_ENABLE_PARSER needs {P}_ENABLE_DECODE"
 #endif
+/* The directions the build decodes ({P}_ROLE): the other side's is refused. */
+#define {P}__DECODES(dir) ((dir) == {P}_REQUEST ? {P}_DECODES_REQUESTS : (dir) == {P}_RESPONSE && {P}_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says ({comment(t.description or "")}) ---- */
 #define {P}__START {_byte(t.start)}            /* {comment(repr(t.start))} */
@@ -576,6 +582,9 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
         return {P}_E_ARG;
     }}
     out->kind = {P}_KIND_NONE;
+    if (!{P}__DECODES(dir)) {{ /* the other side's direction, left out of this build */
+        return {P}_E_ARG;
+    }}
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}

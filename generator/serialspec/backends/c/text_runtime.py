@@ -604,6 +604,11 @@ size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pf
 {
     size_t i;
     *got = false;
+#if PFX_ROLE != PFX_ROLE_BOTH
+    if (!PFX__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return len;
+    }
+#endif
     for (i = 0u; i < len; i++) {
         if (pfx__push(parser, data[i], out)) {
             *got = true;

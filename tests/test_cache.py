@@ -350,21 +350,35 @@ def test_a_damaged_model_entry_is_resolved_again(folder: Path) -> None:
     assert protocols.resolved(str(spec), "vesc.yaml", data) == fresh
 
 
-def test_decode_by_package_name_imports_neither_yaml_nor_the_resolver(tmp_path: Path) -> None:
-    """The start-up work `decode PACKAGE HEX` does, once the model is cached (bench/startup.py times it)."""
+def _decode_imports(tmp_path: Path, *options: str) -> list[str]:
+    """The output of `decode feetech_sms PING` in a fresh process, then which of the heavy modules it imported."""
     code = (
         "import sys\n"
         "from serialspec.cli import main\n"
-        "main(['decode', 'feetech_sms', 'ff ff 01 02 01 fb', '--direction', 'request'])\n"
-        "print(sorted(m for m in sys.modules if m in ('yaml', 'serialspec.lang.resolve', 'serial', 'shutil',"
-        " 'serialspec.runtime.transport', 'serialspec.runtime.device')))\n"
+        f"main(['decode', 'feetech_sms', 'ff ff 01 02 01 fb', '--direction', 'request', *{options!r}])\n"
+        "print(sorted(m for m in sys.modules if m in ('yaml', 'serialspec.lang.resolve', 'serialspec.lang.model', "
+        "'serial', 'shutil', 'serialspec.runtime.transport', 'serialspec.runtime.device', 'dataclasses', 'inspect', "
+        "'pickle')))\n"
     )
     env = {"SERIALSPEC_CACHE_DIR": str(tmp_path / "cache"), "PATH": ""}
-    first = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
-    assert first.stdout.splitlines()[-1] == "['serialspec.lang.resolve', 'yaml']"  # resolved once, and stored
-    again = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
-    assert again.stdout.splitlines()[:2] == [
-        "feetech_sms request ping  [ff ff 01 02 01 fb]",
-        "  id                   1",
-    ]
-    assert again.stdout.splitlines()[-1] == "[]"
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
+
+
+def test_decode_by_package_name_imports_neither_the_model_nor_dataclasses(tmp_path: Path) -> None:
+    """The start-up work `decode PACKAGE HEX` does (bench/startup.py times it): the generated package answers alone,
+    without the spec's model (not even from the cache: no pickle), the language, dataclasses or inspect."""
+    for _ in range(2):  # the first run too: nothing is resolved
+        assert _decode_imports(tmp_path).splitlines() == [
+            "feetech_sms request ping  [ff ff 01 02 01 fb]",
+            "  id                   1",
+            "[]",
+        ]
+
+
+def test_decode_with_units_takes_the_model_from_the_cache(tmp_path: Path) -> None:
+    """What needs the spec (--units, --request, --file) reads its model, resolved once and then from the cache."""
+    first = _decode_imports(tmp_path, "--units").splitlines()
+    assert "'serialspec.lang.resolve', " in first[-1] and "'yaml'" in first[-1]  # resolved once, and stored
+    again = _decode_imports(tmp_path, "--units").splitlines()
+    assert again[:2] == ["feetech_sms request ping  [ff ff 01 02 01 fb]", "  id                   1"]
+    assert "resolve" not in again[-1] and "yaml" not in again[-1] and "'serialspec.lang.model'" in again[-1]

@@ -31,6 +31,14 @@ MODELS: dict[int, str] = {
     2825: 'sts3250',
     11272: 'sm8512bl',
 }
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
+#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
+#: address, register map in `registers`).
+CHECKSUMMED: tuple[str, ...] = ('request', 'response')
+REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {
+    'WriteRequest': ('data', 'address', 'CONTROL_TABLE'),
+    'RegWriteRequest': ('data', 'address', 'CONTROL_TABLE'),
+}
 
-__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "MODELS", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
+__all__ = ["BAUDRATE", "CHECKSUMMED", "MATCH_BY", "MESSAGE_TYPES", "MODELS", "PROTOCOL", "REGISTER_VIEWS", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
            *_messages]

@@ -26,6 +26,11 @@ BAUDRATE = 19200
 SERIAL = SerialSettings(baudrate=19200, bytesize=8, parity='even', stopbits=1.0, gap=3.5)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('unit', 'command')
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
+#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
+#: address, register map in `registers`).
+CHECKSUMMED: tuple[str, ...] = ('request', 'response')
+REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {}
 
-__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
+__all__ = ["BAUDRATE", "CHECKSUMMED", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "REGISTER_VIEWS", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
            *_messages]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import os
 import sys
@@ -48,14 +49,27 @@ class _Formatter(argparse.HelpFormatter):
         super().__init__(prog, width=max(columns, 10) - 2)
 
 
+def _translate_once() -> None:
+    """argparse looks each of its texts ('usage: ', 'options', ...) up in gettext's catalogues every time it uses one,
+    a search of the locale's folders each time (some 45 while the parser is built, a third of the command's start):
+    each text is looked up once. The translations are the same (the locale does not change while the command runs)."""
+    if not hasattr(argparse._, "cache_info"):  # type: ignore[attr-defined]
+        argparse._ = functools.cache(argparse._)  # type: ignore[attr-defined]
+
+
 def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
     """The command's parser, with the arguments of the `chosen` verbs only (each verb's module is imported for its
-    arguments), and each verb's own parser."""
+    arguments), and each verb's own parser: of every verb, or where the chosen verbs are all known, of those alone (a
+    verb's parser costs as much to build as a verb's imports; `serialspec --help` lists them all)."""
+    _translate_once()
+    only = bool(chosen) and all(name in VERBS for name in chosen)
     parser = argparse.ArgumentParser(prog="serialspec", description=DESCRIPTION, formatter_class=_Formatter)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     subparsers = {}
     for name, text in VERBS.items():
+        if only and name not in chosen:
+            continue
         sub = subparsers[name] = verbs.add_parser(name, help=text, description=text, formatter_class=_Formatter)
         if name in chosen:
             module = importlib.import_module(f"{__name__}.{name}")

@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable
 from types import ModuleType
-from typing import TYPE_CHECKING, Any
 
-from serialspec.cli.protocols import SPEC_HELP, open_spec
-from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
-from serialspec.lang.model import Protocol, replies_by_request, reply_to
+from serialspec.cli.protocols import SPEC_HELP, installed_package, open_spec, submodule
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
-from serialspec.runtime.message import Message
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
+    from typing import Any
+
     from serialspec.cli.frames import Seen
+    from serialspec.lang.model import Protocol
+    from serialspec.runtime.message import Message
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,6 +46,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not args.hex and not args.file:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
+    alone = None if args.file or args.request or args.units else package_alone(args.spec)
+    if alone is not None:  # the package answers alone: the spec's model is not loaded
+        return decode_frames(
+            args, lambda frame: alone.decode(frame, args.direction, None), lambda m, f: describe_alone(alone, m, f)
+        )
     protocol, package = open_spec(args.spec)
     if protocol.text is not None:
         if args.request or args.units:
@@ -57,6 +64,9 @@ def run(args: argparse.Namespace) -> int:
             return replay(args, protocol, package)
         sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
         return textframes.decode(protocol, package, sentences, args.json, args.direction)
+    from serialspec.cli.views import message_spec
+    from serialspec.lang.model import replies_by_request, reply_to
+
     request = None
     expect = None  # the reply layout the request gets, where replies share a code
     if args.request:
@@ -65,23 +75,60 @@ def run(args: argparse.Namespace) -> int:
         expect = next((c for c in package.MESSAGE_TYPES if reply and c.__name__ == reply.class_name), None)
     if args.file:
         return replay(args, protocol, package)
+
+    def decode(frame: bytes) -> Message:
+        if request is not None and (protocol.framing.by_command or protocol.framing.from_request):
+            return package.decode(frame, args.direction, expect, request)  # type: ignore[no-any-return]
+        return package.decode(frame, args.direction, expect)  # type: ignore[no-any-return]
+
+    return decode_frames(args, decode, lambda m, f: describe(protocol, m, f, args.units, request))
+
+
+def decode_frames(
+    args: argparse.Namespace,
+    decode: Callable[[bytes], Message],
+    described: Callable[[Message, bytes], dict[str, Any]],
+) -> int:
+    """Decode the frames given as arguments (or one a line on stdin), each shown or its error told in one line."""
     frames = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
     failed = 0
     for text in frames:
         try:
             frame = _hex(text)
-            if request is not None and (protocol.framing.by_command or protocol.framing.from_request):
-                message = package.decode(frame, args.direction, expect, request)  # replies read with their request
-            else:
-                message = package.decode(frame, args.direction, expect)
+            message = decode(frame)
         except (DecodeError, SerialspecError) as exc:
             hint = " (--direction request|response)" if str(exc).startswith("give the direction") else ""
             hint = " (--request HEX)" if str(exc).endswith("give the request") else hint
             print(f"serialspec decode: {text.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue
-        show(describe(protocol, message, frame, args.units, request), args.json)
+        show(described(message, frame), args.json)
     return 1 if failed else 0
+
+
+def package_alone(spec: str) -> ModuleType | None:
+    """The generated package of a protocol given by name, when it answers `decode` alone: a binary protocol's package
+    that names the directions whose frames carry a checksum and its messages' register views (CHECKSUMMED,
+    REGISTER_VIEWS). Then neither the spec's model nor the spec language is imported. None for a spec file (or a
+    file of that name here), a text protocol's package or one generated before these names."""
+    if not spec.isidentifier() or os.path.isfile(spec):
+        return None
+    package, _, _ = installed_package(spec)
+    return package if hasattr(package, "CHECKSUMMED") and hasattr(package, "REGISTER_VIEWS") else None
+
+
+def describe_alone(package: ModuleType, message: Message, frame: bytes) -> dict[str, Any]:
+    """`describe` (without units or a request) from what the generated package says."""
+    registers = None
+    view = package.REGISTER_VIEWS.get(type(message).__name__)
+    if view is not None:
+        field, start_name, constant = view
+        start = message.to_fields().get(start_name)
+        maps = submodule(package, "registers")
+        if isinstance(start, int) and maps is not None:
+            registers = dict(getattr(maps, constant).unpack(start, getattr(message, field)))
+    checksum = message.DIRECTION.value in package.CHECKSUMMED
+    return result(package.PROTOCOL, message, frame, message.to_fields(), checksum, registers, {})
 
 
 def show(result: dict[str, Any], as_json: bool, lines: Callable[[dict[str, Any]], str] | None = None) -> None:
@@ -100,6 +147,8 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
     (registers by name, as `--request` does)."""
     from serialspec.cli import capture, textframes
     from serialspec.cli.frames import Frames
+    from serialspec.cli.views import message_spec
+    from serialspec.lang.model import replies_by_request, reply_to
 
     text = protocol.text is not None
     address = protocol.device.address if protocol.device else None
@@ -176,24 +225,39 @@ def _has_checksum(protocol: Protocol, direction: str) -> bool:
 def describe(
     protocol: Protocol, message: Message, frame: bytes, units: bool, request: Message | None
 ) -> dict[str, Any]:
+    from serialspec.cli.views import engineering, register_view, unit_symbols
+
     fields = message.to_fields()
     symbols = {}
     if units:
         fields = engineering(protocol, message, fields)
         symbols = unit_symbols(protocol, message)
+    checksum = _has_checksum(protocol, message.DIRECTION.value)
+    return result(protocol.name, message, frame, fields, checksum, register_view(protocol, message, request), symbols)
+
+
+def result(
+    protocol: str,
+    message: Message,
+    frame: bytes,
+    fields: dict[str, Any],
+    checksum: bool,
+    registers: dict[str, Any] | None,
+    symbols: dict[str, str],
+) -> dict[str, Any]:
+    """A decoded frame as `--json` prints it."""
     result: dict[str, Any] = {
-        "protocol": protocol.name,
+        "protocol": protocol,
         "direction": message.DIRECTION.value,
         "command": message.COMMAND,
         "subcommand": message.SUBCOMMAND,
         "fields": fields,
         # a frame whose checksum fails does not decode; null where its direction's frames carry none
-        "checksum_ok": True if _has_checksum(protocol, message.DIRECTION.value) else None,
+        "checksum_ok": True if checksum else None,
         "hex": frame.hex(" "),
     }
     if symbols:
         result["units"] = symbols
-    registers = register_view(protocol, message, request)
     if registers is not None:
         result["registers"] = registers
     return result
@@ -205,15 +269,21 @@ def readable(result: dict[str, Any]) -> str:
     lines = [f"{when}{result['protocol']} {result['direction']} {title}  [{result['hex']}]"]
     units = result.get("units", {})
     for name, value in result["fields"].items():
-        text = with_unit(_value(value), units[name]) if name in units else _value(value)
+        text = _with_unit(_value(value), units[name]) if name in units else _value(value)
         lines.append(f"  {name:<20} {text}")
     for name, value in (result.get("registers") or {}).items():
         lines.append(f"  register {name:<11} {_value(value)}")
     return "\n".join(lines)
 
 
+def _with_unit(value: str, unit: str) -> str:
+    from serialspec.cli.views import with_unit
+
+    return with_unit(value, unit)
+
+
 def _value(value: Any) -> str:
-    if isinstance(value, FlagNames):
+    if isinstance(value, list) and type(value) is not list:  # views.FlagNames (--units): the flags' names as words
         return str(value)
     if isinstance(value, dict | list):
         import json

@@ -5,7 +5,10 @@ checksum registry import: each algorithm's runtime function now lives in its mod
 from __future__ import annotations
 
 import importlib
-from typing import Any
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 # Each byte value as a one-byte bytes object: appending a 1-byte checksum is an index, not a bytes((x,)) call.
 BYTE_VALUES: tuple[bytes, ...] = tuple(bytes((value,)) for value in range(256))

@@ -5,11 +5,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping
 from enum import IntEnum, IntFlag
-from typing import Any, TypeVar
 
 from serialspec.runtime.errors import EncodeError, shown
 from serialspec.runtime.hexbytes import parse_hex
-from serialspec.runtime.message import Record, is_sequence
+from serialspec.runtime.message import TYPE_CHECKING, Record, is_sequence
 
 
 def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable[str], where: str) -> None:
@@ -69,8 +68,11 @@ def optional_bytes(data: Mapping[str, Any], name: str, where: str) -> bytes | No
     return None if value is None else as_bytes(value, name, where)
 
 
-E = TypeVar("E", bound=IntEnum)
-F = TypeVar("F", bound=IntFlag)
+if TYPE_CHECKING:
+    from typing import Any, TypeVar
+
+    E = TypeVar("E", bound=IntEnum)
+    F = TypeVar("F", bound=IntFlag)
 
 
 def integer(value: Any, name: str, where: str) -> int:

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import inspect
 import keyword
 from collections import _tuplegetter  # type: ignore[attr-defined]
 from collections.abc import Callable
-from dataclasses import FrozenInstanceError
 from enum import Enum, IntEnum, StrEnum
-from typing import TYPE_CHECKING, Any, ClassVar, TypeGuard, TypeVar, dataclass_transform
+
+# typing.TYPE_CHECKING without importing typing: typing takes about a fifth of a bare Python start, and nothing
+# that `serialspec decode PACKAGE` or a generated package imports needs it at run time (tests/test_cache.py)
+TYPE_CHECKING = False
 
 
 class Direction(StrEnum):
@@ -16,9 +17,12 @@ class Direction(StrEnum):
     RESPONSE = "response"
 
 
-R = TypeVar("R", bound="Record")
-
 if TYPE_CHECKING:  # to a type checker a record is a plain object with frozen attributes, not a sequence
+    from typing import Any, ClassVar, TypeGuard, TypeVar, dataclass_transform
+
+    R = TypeVar("R", bound="Record")
+    E = TypeVar("E", bound=IntEnum)
+    M = TypeVar("M", bound=Enum)
     _Base = object
 
     def build(cls: type[R], values: tuple[Any, ...], /) -> R:
@@ -28,6 +32,9 @@ if TYPE_CHECKING:  # to a type checker a record is a plain object with frozen at
 else:
     _Base = tuple
     build = tuple.__new__
+
+    def dataclass_transform(**_: object) -> Callable[[type], type]:
+        return lambda cls: cls  # what typing's does at run time, but for a marker attribute
 
 
 _ALL = slice(None)
@@ -65,9 +72,13 @@ class Record(_Base):
             setattr(cls, name, _tuplegetter(index, f"Field {index} of {cls.__name__}: {name}."))
 
     def __setattr__(self, name: str, value: Any) -> None:
+        from dataclasses import FrozenInstanceError  # imported when raised: dataclasses imports inspect and ast
+
         raise FrozenInstanceError(f"cannot assign to field {name!r}")
 
     def __delattr__(self, name: str) -> None:
+        from dataclasses import FrozenInstanceError
+
         raise FrozenInstanceError(f"cannot delete field {name!r}")
 
     def _values(self) -> tuple[Any, ...]:
@@ -159,10 +170,6 @@ class Message(Record):
         raise NotImplementedError
 
 
-E = TypeVar("E", bound=IntEnum)
-M = TypeVar("M", bound=Enum)
-
-
 def enum_or_int(enum: type[E], value: int) -> E | int:
     """The enum member for a wire value, or the plain value when the spec names none (no data is dropped)."""
     return enum._value2member_map_.get(value, value)  # type: ignore[return-value]
@@ -209,6 +216,8 @@ def compare(value: float | None, op: str, operand: float) -> bool:
 
 def takes_request(function: Callable[..., Any]) -> bool:
     """Whether a codec's encode or decode takes `request` (its replies are made and read with their request)."""
+    import inspect  # only here: importing it costs more than a generated package's import
+
     try:
         return "request" in inspect.signature(function).parameters
     except (TypeError, ValueError):  # no signature to read: an ordinary codec

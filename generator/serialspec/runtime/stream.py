@@ -15,20 +15,37 @@ the real frame inside it). So any split of a stream into reads gives the same fr
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
 from itertools import islice
-from typing import Literal
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.runtime.message import Message
+from serialspec.runtime.message import TYPE_CHECKING, Message
 
 # frame-level values with a declared range: (offset, size, byte order, signed, low, high, also allowed or None)
-ValueRanges = tuple[tuple[int, int, Literal["little", "big"], bool, int, int, int | None], ...]
+if TYPE_CHECKING:
+    from typing import Literal
+
+    ValueRanges = tuple[tuple[int, int, Literal["little", "big"], bool, int, int, int | None], ...]
+else:  # the same without importing typing for Literal
+    ValueRanges = tuple[tuple[int, int, str, bool, int, int, int | None], ...]
 
 
-@dataclass(frozen=True)
 class FrameFormat:
-    """What the stream parser needs of one direction's frame; generated from the spec."""
+    """What the stream parser needs of one direction's frame; generated from the spec. Frozen (a plain class: the
+    dataclass it was made importing dataclasses cost a generated package's import more than the rest of it)."""
+
+    __slots__ = (
+        "header",
+        "overhead",
+        "length_offset",
+        "length_adds",
+        "command_offset",
+        "content_sizes",
+        "decode_at",
+        "fixed",
+        "value_ranges",
+        "summed",
+        "runs",
+    )
 
     header: bytes
     overhead: int  # frame size minus content size
@@ -42,13 +59,39 @@ class FrameFormat:
     decode_at: Callable[[bytes, int, int], Message]
     # Frames of one size decoded whole, by size key: (frame size, decoder(buffer, start) -> message, or None when
     # its checksum fails). The parser uses them before decode_at; frames not here take decode_at.
-    fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = field(default_factory=dict)
-    value_ranges: ValueRanges = ()  # a candidate with a value outside its range is no frame
+    fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]]
+    value_ranges: ValueRanges  # a candidate with a value outside its range is no frame
     # Where the checksum is the frame's last byte, the 8-bit sum of its bytes from `summed[0]` on (inverted when
     # summed[1]): the frames decoded in runs, by size key: runs[key](frames) gives the messages of frames of that key
     # laid end to end without their headers, each checked already (their message is their content as unpacked).
-    summed: tuple[int, bool] | None = None
-    runs: dict[int, Callable[[bytes], Iterable[Message]]] = field(default_factory=dict)
+    summed: tuple[int, bool] | None
+    runs: dict[int, Callable[[bytes], Iterable[Message]]]
+
+    def __init__(
+        self,
+        header: bytes,
+        overhead: int,
+        length_offset: int,
+        length_adds: int,
+        command_offset: int | None,
+        content_sizes: dict[int | None, tuple[int, int | None]],
+        decode_at: Callable[[bytes, int, int], Message],
+        fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] | None = None,
+        value_ranges: ValueRanges = (),
+        summed: tuple[int, bool] | None = None,
+        runs: dict[int, Callable[[bytes], Iterable[Message]]] | None = None,
+    ) -> None:
+        values: tuple[object, ...] = (header, overhead, length_offset, length_adds, command_offset, content_sizes)
+        values += (decode_at, {} if fixed is None else fixed, value_ranges, summed, {} if runs is None else runs)
+        for name, value in zip(self.__slots__, values, strict=True):
+            object.__setattr__(self, name, value)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"FrameFormat is frozen: cannot assign to {name!r}")
+
+    def __repr__(self) -> str:
+        values = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__slots__)
+        return f"FrameFormat({values})"
 
 
 class _Candidate:

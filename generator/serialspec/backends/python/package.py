@@ -21,6 +21,7 @@ from serialspec.backends.python.simulator import simulator_module
 from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
+    Bytes,
     Group,
     Message,
     Protocol,
@@ -28,7 +29,7 @@ from serialspec.lang.model import (
     Table,
     TableValue,
 )
-from serialspec.lang.names import python_view, spec_name
+from serialspec.lang.names import python_name, python_view, spec_name
 
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
@@ -123,6 +124,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             match_by=repr(protocol.matching),
             models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
             model_entry=protocol.device.model_entry if protocol.device else "",
+            checksummed=repr(checksummed_directions(protocol)),
+            register_views=register_views(spec),
         ),
         "client.py": client_module(protocol),
         "py.typed": "",
@@ -132,6 +135,24 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     if protocol.device is not None:
         files["simulator.py"] = simulator_module(spec)
     return files
+
+
+def checksummed_directions(protocol: Protocol) -> tuple[str, ...]:
+    """The directions whose frames carry a checksum (in any of their layouts)."""
+    return tuple(
+        d.value for d, layouts in protocol.framing.alternatives.items() if any(layout.checksums for layout in layouts)
+    )
+
+
+def register_views(spec: Protocol) -> list[tuple[str, str, str, str]]:
+    """(class, bytes field's attribute, start field's spec name, register map constant) of each message whose bytes
+    are a run of registers starting at a field of its own (the first such field: what `serialspec decode` shows)."""
+    views = []
+    for message in spec.messages():
+        f = next((f for f in message.fields if isinstance(f, Bytes) and f.table is not None and f.start), None)
+        if isinstance(f, Bytes) and f.table is not None and not f.start_in_request:
+            views.append((message.class_name, python_name(f.name), f.start, f.table.constant))
+    return views
 
 
 # The runtime's helpers that build fields from data, by the name generated code calls them (serialspec.runtime.fields).

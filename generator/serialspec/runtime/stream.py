@@ -79,6 +79,8 @@ class _Candidate:
         "sum_table",
         "smallest",
         "tails",
+        "leading",
+        "lean",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -142,6 +144,19 @@ class _Candidate:
             for offset, shift in ((frame_format.command_offset, 8), (frame_format.length_offset, 0))
             if offset is not None
         )
+        # Where the key's bytes are the first bytes after the header (Fashion Star: command code, length byte) and
+        # the header cannot overlap itself, _lean reads the key as those bytes: `lean` maps them to the frame's size
+        # and decoder (None: decode_at), for the candidates the scan decides on the spot.
+        key_at = {frame_format.length_offset: 0}  # each key byte's offset: its shift in the size key
+        if frame_format.command_offset is not None:
+            key_at[frame_format.command_offset] = 8
+        leading = sorted(key_at) == list(range(width, width + len(key_at)))
+        self.leading = len(key_at) if leading and self.splittable and not self.shifts and not self.ranges else 0
+        self.lean: dict[bytes, tuple[int, int, Callable[[bytes, int], Message | None] | None]] = {}
+        if self.leading:
+            for key, size in self.frame_sizes.items():
+                first = bytes(key >> key_at[offset] & 0xFF for offset in sorted(key_at))
+                self.lean[first] = (size, size - width, self.fixed.get(key))
         self.sum_from, self.sum_table = 0, b""
         if summed is not None:
             covered_from, invert = summed
@@ -265,7 +280,12 @@ class StreamParser:
                     if message is not None:
                         self._pending = b""
                         return [message]
-        found = self._split(buffer, single) if single.splittable and end >= _SPLIT_FROM else self._walk(buffer, single)
+        if single.splittable and end >= _SPLIT_FROM:
+            found = self._split(buffer, single)
+        elif single.leading:
+            found = self._lean(buffer, single)
+        else:
+            found = self._walk(buffer, single)
         held = self._pending
         if held.startswith(single.header) and held.find(single.header, 1) < 0:
             # the candidate held back, with no header after its first byte: feed() waits for its bytes (or for the
@@ -346,6 +366,64 @@ class StreamParser:
                 position = after
         else:  # keep a tail that could begin a header
             cut = max(start, end - len(header) + 1)
+        self._pending = buffer[cut:]
+        self.garbage += cut - taken
+        self.errors += errors
+        return found
+
+    def _lean(self, buffer: bytes, current: _Candidate) -> list[Message]:
+        """The byte-by-byte scan (`_scan`) of a format whose header cannot overlap itself and whose size key is the
+        bytes right after it, for a read of a few frames: split at every header, the usual piece (the bytes after a
+        header) begins with a whole frame: one slice and one lookup find its size and decoder, and its length says
+        no header starts inside it (no frame can complete before it), so it is taken or refused on the spot. A
+        piece whose key bytes name no frame is no frame. Every other candidate goes through `_decide`."""
+        header = current.header
+        width = len(header)
+        pieces = buffer.split(header)
+        lean, leading = current.lean, current.leading
+        decode_at = current.decode
+        found: list[Message] = []
+        append = found.append
+        position = len(pieces[0])  # of the header before the piece
+        start = taken = errors = 0  # start: where the scan would look next (the end of the last frame taken)
+        for piece in islice(pieces, 1, None):
+            if position >= start:
+                entry = lean.get(piece[:leading])
+                if entry is not None:
+                    size, rest, decode = entry
+                    if rest <= len(piece):  # the whole frame, and no header inside it
+                        if decode is not None:
+                            message = decode(buffer, position)
+                        else:
+                            try:
+                                message = decode_at(buffer, position, position + size)
+                            except DecodeError:
+                                message = None
+                        if message is None:  # corrupt: look again at the next header
+                            errors += 1
+                        else:
+                            append(message)
+                            taken += size
+                            start = position + size
+                        position += width + len(piece)
+                        continue
+                elif len(piece) >= leading:  # its key bytes name no frame
+                    position += width + len(piece)
+                    continue
+                decided = self._decide(buffer, position, current)
+                if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
+                    cut = position
+                    break
+                message, where, stop = decided
+                if message is not None:  # this candidate, or a frame inside it that completes first
+                    append(message)
+                    taken += stop - where
+                    start = stop
+                else:
+                    errors += stop  # 1: a corrupt frame; 0: no frame
+            position += width + len(piece)
+        else:  # keep a tail that could begin a header
+            cut = max(start, len(buffer) - width + 1)
         self._pending = buffer[cut:]
         self.garbage += cut - taken
         self.errors += errors

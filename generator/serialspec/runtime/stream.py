@@ -199,6 +199,7 @@ _CANDIDATES: dict[int, _Candidate] = {}
 # _FIRST_RUN pieces at most at first, and twice as many after each run that took at least half of them.
 # Buffers of _SPLIT_FROM bytes or more take the batch scan (StreamParser._split), shorter ones the walk (_walk).
 _SPLIT_FROM = 512
+_RUNS_AGAIN = 8
 _SHORTEST_RUN = 24
 _FIRST_RUN = 32
 _LONGEST_RUN = 1024
@@ -229,6 +230,9 @@ class StreamParser:
         self._smallest = min(c.smallest for c in self._candidates)
         # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
         self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
+        # whether the last batch scan took half of its frames or more in runs; frames runs took in it; long reads
+        # the lean scan took since (see feed)
+        self._runs_pay, self._ran, self._lean_reads = True, 0, 0
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
 
@@ -280,8 +284,12 @@ class StreamParser:
                     if message is not None:
                         self._pending = b""
                         return [message]
-        if single.splittable and end >= _SPLIT_FROM:
+        if single.splittable and end >= _SPLIT_FROM and (not single.leading or self._runs_pay or self._retry_runs()):
+            self._ran = 0
             found = self._split(buffer, single)
+            # where runs took less than half of the frames, the lean scan costs less: it takes the long reads too
+            # (the batch scan, tried again every _RUNS_AGAIN long reads, tells when runs pay again)
+            self._runs_pay = 2 * self._ran >= len(found)
         elif single.leading:
             found = self._lean(buffer, single)
         else:
@@ -371,6 +379,14 @@ class StreamParser:
         self.errors += errors
         return found
 
+    def _retry_runs(self) -> bool:
+        """Whether this long read tries the batch scan again (every _RUNS_AGAIN-th since runs stopped paying)."""
+        self._lean_reads += 1
+        if self._lean_reads < _RUNS_AGAIN:
+            return False
+        self._lean_reads = 0
+        return True
+
     def _lean(self, buffer: bytes, current: _Candidate) -> list[Message]:
         """The byte-by-byte scan (`_scan`) of a format whose header cannot overlap itself and whose size key is the
         bytes right after it, for a read of a few frames: split at every header, the usual piece (the bytes after a
@@ -382,6 +398,7 @@ class StreamParser:
         pieces = buffer.split(header)
         lean, leading = current.lean, current.leading
         decode_at = current.decode
+        smallest, end = self._smallest, len(buffer)
         found: list[Message] = []
         append = found.append
         position = len(pieces[0])  # of the header before the piece
@@ -389,9 +406,12 @@ class StreamParser:
         for piece in islice(pieces, 1, None):
             if position >= start:
                 entry = lean.get(piece[:leading])
+                after = len(piece)  # bytes before the next header (or the end)
                 if entry is not None:
                     size, rest, decode = entry
-                    if rest <= len(piece):  # the whole frame, and no header inside it
+                    # the whole frame, and no header inside it; or a header inside it, too late for a frame from
+                    # there to complete first (a cut frame start: the frame that follows it is no inner frame)
+                    if rest <= after or (after + smallest >= rest and position + size <= end):
                         if decode is not None:
                             message = decode(buffer, position)
                         else:
@@ -405,11 +425,17 @@ class StreamParser:
                             append(message)
                             taken += size
                             start = position + size
-                        position += width + len(piece)
+                        position += width + after
                         continue
-                elif len(piece) >= leading:  # its key bytes name no frame
-                    position += width + len(piece)
+                    if position + width + after == end:  # the last candidate, not all here: wait for its bytes
+                        cut = position
+                        break
+                elif after >= leading:  # its key bytes name no frame
+                    position += width + after
                     continue
+                elif position + width + after == end:  # the last candidate, its key not all here: wait for it
+                    cut = position
+                    break
                 decided = self._decide(buffer, position, current)
                 if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
                     cut = position
@@ -423,7 +449,7 @@ class StreamParser:
                     errors += stop  # 1: a corrupt frame; 0: no frame
             position += width + len(piece)
         else:  # keep a tail that could begin a header
-            cut = max(start, len(buffer) - width + 1)
+            cut = max(start, end - width + 1)
         self._pending = buffer[cut:]
         self.garbage += cut - taken
         self.errors += errors
@@ -482,6 +508,7 @@ class StreamParser:
                             self._backoff = min(2 * self._backoff, _LONGEST_RUN)
                             block = self._block = _FIRST_RUN
                         if count > 1:
+                            self._ran += count
                             found.extend(run(frames))
                             taken += count * size
                             # the header of the run's last frame, its end, and the header after it

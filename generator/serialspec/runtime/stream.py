@@ -359,6 +359,12 @@ class StreamParser:
                     start = stop
                     position = after if after >= stop or after < 0 else find(header, stop)
                     continue
+                if after < 0 and stop > end:  # the last candidate, not all here: wait for its bytes
+                    cut = position
+                    break
+            elif after < 0:  # the last candidate, too short to be sized: wait for its bytes
+                cut = position
+                break
             decided = self._decide(buffer, position, current)
             if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
                 cut = position

@@ -122,6 +122,8 @@ class _Candidate:
         "sum_table",
         "smallest",
         "tails",
+        "leading",
+        "lean",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -185,6 +187,19 @@ class _Candidate:
             for offset, shift in ((frame_format.command_offset, 8), (frame_format.length_offset, 0))
             if offset is not None
         )
+        # Where the key's bytes are the first bytes after the header (Fashion Star: command code, length byte) and
+        # the header cannot overlap itself, _lean reads the key as those bytes: `lean` maps them to the frame's size
+        # and decoder (None: decode_at), for the candidates the scan decides on the spot.
+        key_at = {frame_format.length_offset: 0}  # each key byte's offset: its shift in the size key
+        if frame_format.command_offset is not None:
+            key_at[frame_format.command_offset] = 8
+        leading = sorted(key_at) == list(range(width, width + len(key_at)))
+        self.leading = len(key_at) if leading and self.splittable and not self.shifts and not self.ranges else 0
+        self.lean: dict[bytes, tuple[int, int, Callable[[bytes, int], Message | None] | None]] = {}
+        if self.leading:
+            for key, size in self.frame_sizes.items():
+                first = bytes(key >> key_at[offset] & 0xFF for offset in sorted(key_at))
+                self.lean[first] = (size, size - width, self.fixed.get(key))
         self.sum_from, self.sum_table = 0, b""
         if summed is not None:
             covered_from, invert = summed
@@ -227,6 +242,7 @@ _CANDIDATES: dict[int, _Candidate] = {}
 # _FIRST_RUN pieces at most at first, and twice as many after each run that took at least half of them.
 # Buffers of _SPLIT_FROM bytes or more take the batch scan (StreamParser._split), shorter ones the walk (_walk).
 _SPLIT_FROM = 512
+_RUNS_AGAIN = 8
 _SHORTEST_RUN = 24
 _FIRST_RUN = 32
 _LONGEST_RUN = 1024
@@ -257,6 +273,9 @@ class StreamParser:
         self._smallest = min(c.smallest for c in self._candidates)
         # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
         self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
+        # whether the last batch scan took half of its frames or more in runs; frames runs took in it; long reads
+        # the lean scan took since (see feed)
+        self._runs_pay, self._ran, self._lean_reads = True, 0, 0
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
 
@@ -308,7 +327,16 @@ class StreamParser:
                     if message is not None:
                         self._pending = b""
                         return [message]
-        found = self._split(buffer, single) if single.splittable and end >= _SPLIT_FROM else self._walk(buffer, single)
+        if single.splittable and end >= _SPLIT_FROM and (not single.leading or self._runs_pay or self._retry_runs()):
+            self._ran = 0
+            found = self._split(buffer, single)
+            # where runs took less than half of the frames, the lean scan costs less: it takes the long reads too
+            # (the batch scan, tried again every _RUNS_AGAIN long reads, tells when runs pay again)
+            self._runs_pay = 2 * self._ran >= len(found)
+        elif single.leading:
+            found = self._lean(buffer, single)
+        else:
+            found = self._walk(buffer, single)
         held = self._pending
         if held.startswith(single.header) and held.find(single.header, 1) < 0:
             # the candidate held back, with no header after its first byte: feed() waits for its bytes (or for the
@@ -374,6 +402,12 @@ class StreamParser:
                     start = stop
                     position = after if after >= stop or after < 0 else find(header, stop)
                     continue
+                if after < 0 and stop > end:  # the last candidate, not all here: wait for its bytes
+                    cut = position
+                    break
+            elif after < 0:  # the last candidate, too short to be sized: wait for its bytes
+                cut = position
+                break
             decided = self._decide(buffer, position, current)
             if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
                 cut = position
@@ -389,6 +423,82 @@ class StreamParser:
                 position = after
         else:  # keep a tail that could begin a header
             cut = max(start, end - len(header) + 1)
+        self._pending = buffer[cut:]
+        self.garbage += cut - taken
+        self.errors += errors
+        return found
+
+    def _retry_runs(self) -> bool:
+        """Whether this long read tries the batch scan again (every _RUNS_AGAIN-th since runs stopped paying)."""
+        self._lean_reads += 1
+        if self._lean_reads < _RUNS_AGAIN:
+            return False
+        self._lean_reads = 0
+        return True
+
+    def _lean(self, buffer: bytes, current: _Candidate) -> list[Message]:
+        """The byte-by-byte scan (`_scan`) of a format whose header cannot overlap itself and whose size key is the
+        bytes right after it, for a read of a few frames: split at every header, the usual piece (the bytes after a
+        header) begins with a whole frame: one slice and one lookup find its size and decoder, and its length says
+        no header starts inside it (no frame can complete before it), so it is taken or refused on the spot. A
+        piece whose key bytes name no frame is no frame. Every other candidate goes through `_decide`."""
+        header = current.header
+        width = len(header)
+        pieces = buffer.split(header)
+        lean, leading = current.lean, current.leading
+        decode_at = current.decode
+        smallest, end = self._smallest, len(buffer)
+        found: list[Message] = []
+        append = found.append
+        position = len(pieces[0])  # of the header before the piece
+        start = taken = errors = 0  # start: where the scan would look next (the end of the last frame taken)
+        for piece in islice(pieces, 1, None):
+            if position >= start:
+                entry = lean.get(piece[:leading])
+                after = len(piece)  # bytes before the next header (or the end)
+                if entry is not None:
+                    size, rest, decode = entry
+                    # the whole frame, and no header inside it; or a header inside it, too late for a frame from
+                    # there to complete first (a cut frame start: the frame that follows it is no inner frame)
+                    if rest <= after or (after + smallest >= rest and position + size <= end):
+                        if decode is not None:
+                            message = decode(buffer, position)
+                        else:
+                            try:
+                                message = decode_at(buffer, position, position + size)
+                            except DecodeError:
+                                message = None
+                        if message is None:  # corrupt: look again at the next header
+                            errors += 1
+                        else:
+                            append(message)
+                            taken += size
+                            start = position + size
+                        position += width + after
+                        continue
+                    if position + width + after == end:  # the last candidate, not all here: wait for its bytes
+                        cut = position
+                        break
+                elif after >= leading:  # its key bytes name no frame
+                    position += width + after
+                    continue
+                elif position + width + after == end:  # the last candidate, its key not all here: wait for it
+                    cut = position
+                    break
+                decided = self._decide(buffer, position, current)
+                if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
+                    cut = position
+                    break
+                message, where, stop = decided
+                if message is not None:  # this candidate, or a frame inside it that completes first
+                    append(message)
+                    taken += stop - where
+                    start = stop
+                else:
+                    errors += stop  # 1: a corrupt frame; 0: no frame
+            position += width + len(piece)
+        else:  # keep a tail that could begin a header
+            cut = max(start, end - width + 1)
         self._pending = buffer[cut:]
         self.garbage += cut - taken
         self.errors += errors
@@ -447,6 +557,7 @@ class StreamParser:
                             self._backoff = min(2 * self._backoff, _LONGEST_RUN)
                             block = self._block = _FIRST_RUN
                         if count > 1:
+                            self._ran += count
                             found.extend(run(frames))
                             taken += count * size
                             # the header of the run's last frame, its end, and the header after it

@@ -359,14 +359,3 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
 }}
 #endif
 """
-
-
-def replace_parser(ctx: Ctx, text: str) -> str:
-    """The general parser and the probes only it calls, in the source files.py writes, replaced by the one above."""
-    p = ctx.p
-    start = text.index("/* ---- candidates sized:")
-    stop = text.index("\n}\n", text.index(f"static long {p}__probe_at(")) + 3
-    text = text[:start] + text[stop:]
-    start = text.index(f"#if {ctx.P}_ENABLE_PARSER\n/* ---- the stream parser")
-    stop = text.index("\n}\n#endif\n", text.index(f"size_t {p}_parser_feed(")) + len("\n}\n#endif\n")
-    return text[:start] + parser(ctx) + text[stop:]

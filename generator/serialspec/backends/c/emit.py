@@ -1454,6 +1454,7 @@ def files(protocol: Protocol) -> dict[str, str]:
                 if e.checksum is not None:
                     ctx.check_index(e.checksum)
     from serialspec.backends.c.files import header, json_header, json_source, source
+    from serialspec.backends.c.readme import readme
     from serialspec.backends.c.vectors import check_vectors, vectors_header
 
     p = protocol.name
@@ -1464,6 +1465,7 @@ def files(protocol: Protocol) -> dict[str, str]:
         f"{p}/{p}.c": c,
         f"{p}/{p}_json.h": json_header(ctx),
         f"{p}/{p}_json.c": json_source(ctx),
+        f"{p}/README.md": readme(ctx),
         f"{p}/test/vectors.h": vectors_header(ctx),
         f"{p}/test/check_vectors.c": check_vectors(ctx),
     }

@@ -163,6 +163,39 @@ def test_headers_compile_as_cpp11(g: Generated) -> None:
     assert run.returncode == 0, run.stderr.decode()
 
 
+ARM_GCC = shutil.which("arm-none-eabi-gcc")
+
+
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_readme_gives_the_compilers_struct_sizes_and_every_macro(g: Generated, tmp_path: Path) -> None:
+    """generated/c/<p>/README.md (written from the model and the emitter's data, not from the header): every
+    message's struct size and p_msg_t's are what gcc says on LP64 and arm-none-eabi-gcc on the 32-bit ARM EABI,
+    and every capacity macro of the header is in its table with the header's default."""
+    import re
+
+    p = g.protocol.name
+    folder = GENERATED_C / p
+    readme = (folder / "README.md").read_text(encoding="utf-8")
+    sizes = dict(re.findall(r"^`(\w+_t)`, (\d+ B / \d+) B;", readme, re.M))
+    msg = re.search(r"union of every message's struct: (\d+) B / (\d+) B", readme)
+    assert msg is not None and len(sizes) == len(list(g.protocol.messages())), readme[:2000]
+    sizes[f"{p}_msg_t"] = f"{msg[1]} B / {msg[2]}"
+    for compiler_, column in ((ARM_GCC, 0), (GCC, 1)):
+        if compiler_ is None:
+            continue
+        checks = [
+            f"typedef char check_{i}[(sizeof({name}) == {size.split(' B / ')[column]}u) ? 1 : -1];"
+            for i, (name, size) in enumerate(sizes.items())
+        ]
+        source = tmp_path / "sizes.c"
+        source.write_text(f'#include "{p}.h"\n' + "\n".join(checks) + "\n", encoding="utf-8")
+        run = subprocess.run([compiler_, "-std=c99", "-I", str(folder), "-c", str(source), "-o", os.devnull])
+        assert run.returncode == 0, f"{compiler_}: a struct's size differs from the README's"
+    header = (folder / f"{p}.h").read_text(encoding="utf-8")
+    for macro, default in re.findall(r"^#define (\w+_MAX) (\d+)u$", header, re.M):
+        assert f"| `{macro}` | {default} |" in readme
+
+
 def test_several_protocols_link_into_one_program(tmp_path: Path) -> None:
     """Every external name is prefixed: all the protocols' objects link together."""
     assert GCC is not None

@@ -7,7 +7,6 @@ payload truncation needs, refuses the specs it cannot serve, one line each."""
 from __future__ import annotations
 
 import os
-from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -142,51 +141,49 @@ def test_pymavlink_truncates_and_so_do_we() -> None:
         assert mav.decode(head + payload + crc.crc.to_bytes(2, "little"), direction) == decoded
 
 
-@cache
-def unsigned_c_driver() -> Any:
-    """The C target refuses optional frame elements (the signature): its C is generated from the spec without it,
-    which reads and writes unsigned frames (the constant incompat_flags 00 refuses signed ones)."""
-    import yaml
-    from conftest import ROOT, scratch_folder
-    from serialspec.cli import main as serialspec_main
-    from test_c_backend import Driver
-
-    folder = scratch_folder("mavlink-c-")
-    spec = yaml.safe_load((ROOT / "specs" / "mavlink_common.yaml").read_text(encoding="utf-8"))
-    del spec["framing"]["elements"]["signature"]
-    spec["examples"] = {name: e for name, e in spec["examples"].items() if "signature" not in e.get("fields", {})}
-    stripped = folder / "mavlink_common.yaml"
-    stripped.write_text(yaml.safe_dump(spec, sort_keys=False, allow_unicode=True), encoding="utf-8")
-    assert serialspec_main(["generate", str(stripped), "--target", "c", "--out", str(folder / "c")]) == 0
-    return Driver("mavlink_common", folder / "c" / "mavlink_common", folder)
-
-
 @pytest.mark.parametrize("name", sorted(PAIRS))
 def test_the_c_reads_and_truncates_the_frames_pymavlink_packs(name: str) -> None:
-    """generated/c/mavlink_common against pymavlink: its frames (truncated ones included, and the same payload sent
-    whole) decode in C to the Python codec's values, re-encode byte for byte and come out of the C stream parser."""
+    """generated/c/mavlink_common against pymavlink: its frames, unsigned and signed (truncated ones included, and
+    the same payload sent whole), decode in C to the Python codec's values (the 13 signature bytes as `signature`),
+    re-encode byte for byte and come out of the C stream parser back to back, in any split."""
     import json
 
-    from test_c_backend import GCC
+    from test_c_backend import GCC, driver
+    from test_mavlink_signing import signer
 
     if GCC is None:
         pytest.skip("gcc is not installed")
     cls = PAIRS[name][0]
     direction = PAIRS[name][2]
     kind = f"{name.lower()}_{direction}"
-    run = unsigned_c_driver()  # built before hypothesis runs: a failed build is one failure, not one per example
+    run = driver("mavlink_common")  # built before hypothesis runs: a failed build is one failure, not one per example
 
-    @SETTINGS
-    @given(peer_messages(name), st.integers(0, 255), st.integers(1, 255), st.integers(0, 255))
-    def check(message: Any, seq: int, sysid: int, compid: int) -> None:
-        frame = bytes(message.pack(link(sysid, compid, seq)))
+    def c_json(frame: bytes) -> dict[str, Any]:
         decoded = mav.decode(frame, direction)
         expected = {"command": decoded.COMMAND, "subcommand": None, "direction": direction}
-        expected["fields"] = {k: v for k, v in decoded.to_fields().items() if k != "signature"}
+        expected["fields"] = decoded.to_fields()
         (answer,) = run.ask(f"dec {direction} {frame.hex()} {kind}")
         assert answer.startswith("ok ") and json.loads(answer[3:]) == expected, answer
         (answer,) = run.ask(f"rt {direction} {frame.hex()} {kind}")
-        assert answer == f"ok {frame.hex()}"  # cut where pymavlink cuts it
+        assert answer == f"ok {frame.hex()}"  # cut where pymavlink cuts it, signed as it was
+        return expected
+
+    @SETTINGS
+    @given(
+        peer_messages(name),
+        st.integers(0, 255),
+        st.integers(1, 255),
+        st.integers(0, 255),
+        st.integers(0, 255),
+        st.integers(0, 2**48 - 1),
+        st.lists(st.integers(1, 40), min_size=1, max_size=4),
+    )
+    def check(message: Any, seq: int, sysid: int, compid: int, link_id: int, stamp: int, sizes: list[int]) -> None:
+        frame = bytes(message.pack(link(sysid, compid, seq)))
+        expected = c_json(frame)
+        signed = bytes(message.pack(signer(sysid, compid, seq, link_id, stamp)))
+        expected_signed = c_json(signed)
+        assert expected_signed["fields"]["signature"] == signed[-13:].hex(" ")
         full = cls.unpacker.size
         head, payload = bytes([0xFD, full]) + frame[2:10], frame[10:-2] + bytes(full - frame[1])
         crc = mavlink2.x25crc(head[1:] + payload)
@@ -194,9 +191,10 @@ def test_the_c_reads_and_truncates_the_frames_pymavlink_packs(name: str) -> None
         whole = head + payload + crc.crc.to_bytes(2, "little")
         (answer,) = run.ask(f"rt {direction} {whole.hex()} {kind}")
         assert answer == f"ok {frame.hex()}"  # sent whole: read alike, written cut
-        stream = b"\x00\xfd" + whole + frame
-        answers = run.ask(f"stream {direction} 1,3 {stream.hex()}")
-        assert [json.loads(a[4:]) for a in answers if a.startswith("msg ")] == [expected, expected]
+        stream = b"\x00\xfd" + whole + signed + frame + signed
+        answers = run.ask(f"stream {direction} {','.join(map(str, sizes))} {stream.hex()}")
+        messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
+        assert messages == [expected, expected_signed, expected, expected_signed]
 
     check()
 

@@ -35,6 +35,8 @@ typedef char crsf__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define CRSF__RX(dir) (dir)
 #endif
+#define CRSF__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define CRSF__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* CRC-8/DVB-S2: width 8, poly 0xd5, init 0x0, refin false, refout false, xorout 0x0 (check 0xbc). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -71,6 +73,13 @@ static uint32_t crsf__check(uint8_t which, const uint8_t *d, size_t n)
 #define CRSF__ROLE_LENGTH 3u
 #define CRSF__ROLE_CONTENT 4u
 #define CRSF__ROLE_CHECKSUM 5u
+#define CRSF__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define CRSF__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!CRSF__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int crsf__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -94,7 +103,7 @@ typedef struct {
     uint8_t role;     /* CRSF__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (crsf__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -289,7 +298,7 @@ static const uint8_t *crsf__range(const crsf__layout_t *L, const crsf__where_t *
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     crsf__where_t w;
     size_t pos = 0u, i, sz;
@@ -366,6 +375,8 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
             crsf__put(out + pos, e->size, e->big, code);
         } else if (e->role == CRSF__ROLE_VALUE) {
             crsf__put(out + pos, e->size, e->big, values[v++]);
+        } else if (CRSF__OPTIONAL && e->role == CRSF__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != CRSF__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -374,6 +385,7 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const crsf__element_t *e = &L->e[k];
@@ -471,7 +483,7 @@ static int crsf__unwrap(const crsf__layout_t *L, const uint8_t *frame, size_t n,
             *code = crsf__get(bytes, e->size, e->big);
         } else if (e->role == CRSF__ROLE_VALUE) {
             uint32_t value = crsf__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(CRSF__PLAUSIBLE(e, value))) {
                 return CRSF_E_RANGE;
             }
             values[v++] = value;
@@ -542,7 +554,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
             }
         } else if (e->role == CRSF__ROLE_VALUE) {
             uint32_t value = crsf__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(CRSF__PLAUSIBLE(e, value))) {
                 return CRSF__NONE;
             }
         }
@@ -1076,6 +1088,7 @@ static int crsf__unwrap_at(crsf_direction_t dir, uint8_t k, const uint8_t *frame
 #endif
 }
 
+
 /* ---- content decoders ---- */
 /* The content of gps (request): fields in wire order. */
 static int crsf__dec_gps_request(const uint8_t *c, size_t n, crsf_gps_request_t *m)
@@ -1584,22 +1597,27 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
     }
     k = 0u;
     if (!CRSF__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = crsf__header(dir, k, &hl);
             if (hl <= len && crsf__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return CRSF_E_FRAME;
+            return headed ? CRSF_E_LENGTH : CRSF_E_FRAME;
         }
     }
     r = crsf__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != CRSF_OK) {
         return r;
     }
-    r = crsf__decode_content(dir, crsf__has_command(dir, k) ? (long)code : CRSF__NO_CODE, expect, c, clen, values, out);
+    r = crsf__decode_content(dir, crsf__has_command(dir, k) ? (long)code : CRSF__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != CRSF_OK) {
         out->kind = CRSF_KIND_NONE;
     }
@@ -2015,8 +2033,8 @@ static int crsf__enc_device_info_response(const void *mv, uint8_t *c, size_t cap
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int crsf__frame(crsf_direction_t dir, uint32_t code, const uint32_t *values, const void *m, crsf__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int crsf__frame(crsf_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      crsf__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const crsf__layout_t *const *layouts = crsf__layouts(dir, &count);
@@ -2046,7 +2064,7 @@ static int crsf__frame(crsf_direction_t dir, uint32_t code, const uint32_t *valu
         }
         r = enc(m, dst, room, &clen);
         if (r == CRSF_OK) {
-            r = crsf__wrap(L, buf, cap, span, clen, code, values, len);
+            r = crsf__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == CRSF_OK) {
             return r;

@@ -35,6 +35,8 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define DYNAMIXEL_P2__RX(dir) (dir)
 #endif
+#define DYNAMIXEL_P2__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define DYNAMIXEL_P2__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -71,6 +73,13 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
 #define DYNAMIXEL_P2__ROLE_LENGTH 3u
 #define DYNAMIXEL_P2__ROLE_CONTENT 4u
 #define DYNAMIXEL_P2__ROLE_CHECKSUM 5u
+#define DYNAMIXEL_P2__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define DYNAMIXEL_P2__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!DYNAMIXEL_P2__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -94,7 +103,7 @@ typedef struct {
     uint8_t role;     /* DYNAMIXEL_P2__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (dynamixel_p2__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -289,7 +298,7 @@ static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     dynamixel_p2__where_t w;
     size_t pos = 0u, i, sz;
@@ -366,6 +375,8 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
             dynamixel_p2__put(out + pos, e->size, e->big, code);
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
             dynamixel_p2__put(out + pos, e->size, e->big, values[v++]);
+        } else if (DYNAMIXEL_P2__OPTIONAL && e->role == DYNAMIXEL_P2__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != DYNAMIXEL_P2__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -374,6 +385,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
@@ -471,7 +483,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
             *code = dynamixel_p2__get(bytes, e->size, e->big);
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
             uint32_t value = dynamixel_p2__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(DYNAMIXEL_P2__PLAUSIBLE(e, value))) {
                 return DYNAMIXEL_P2_E_RANGE;
             }
             values[v++] = value;
@@ -542,7 +554,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
             }
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
             uint32_t value = dynamixel_p2__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(DYNAMIXEL_P2__PLAUSIBLE(e, value))) {
                 return DYNAMIXEL_P2__NONE;
             }
         }
@@ -869,6 +881,7 @@ static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, cons
     return DYNAMIXEL_P2_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
@@ -1297,22 +1310,27 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     }
     k = 0u;
     if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = dynamixel_p2__header(dir, k, &hl);
             if (hl <= len && dynamixel_p2__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return DYNAMIXEL_P2_E_FRAME;
+            return headed ? DYNAMIXEL_P2_E_LENGTH : DYNAMIXEL_P2_E_FRAME;
         }
     }
     r = dynamixel_p2__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != DYNAMIXEL_P2_OK) {
         return r;
     }
-    r = dynamixel_p2__decode_content(dir, dynamixel_p2__has_command(dir, k) ? (long)code : DYNAMIXEL_P2__NO_CODE, expect, c, clen, values, out);
+    r = dynamixel_p2__decode_content(dir, dynamixel_p2__has_command(dir, k) ? (long)code : DYNAMIXEL_P2__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != DYNAMIXEL_P2_OK) {
         out->kind = DYNAMIXEL_P2_KIND_NONE;
     }
@@ -1669,8 +1687,8 @@ static int dynamixel_p2__enc_status_response(const void *mv, uint8_t *c, size_t 
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, const uint32_t *values, const void *m, dynamixel_p2__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      dynamixel_p2__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(dir, &count);
@@ -1700,7 +1718,7 @@ static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, cons
         }
         r = enc(m, dst, room, &clen);
         if (r == DYNAMIXEL_P2_OK) {
-            r = dynamixel_p2__wrap(L, buf, cap, span, clen, code, values, len);
+            r = dynamixel_p2__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == DYNAMIXEL_P2_OK) {
             return r;

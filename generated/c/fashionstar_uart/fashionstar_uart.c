@@ -35,6 +35,8 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define FASHIONSTAR_UART__RX(dir) (dir)
 #endif
+#define FASHIONSTAR_UART__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define FASHIONSTAR_UART__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
@@ -67,6 +69,13 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 #define FASHIONSTAR_UART__ROLE_LENGTH 3u
 #define FASHIONSTAR_UART__ROLE_CONTENT 4u
 #define FASHIONSTAR_UART__ROLE_CHECKSUM 5u
+#define FASHIONSTAR_UART__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define FASHIONSTAR_UART__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!FASHIONSTAR_UART__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -90,7 +99,7 @@ typedef struct {
     uint8_t role;     /* FASHIONSTAR_UART__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (fashionstar_uart__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -285,7 +294,7 @@ static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     fashionstar_uart__where_t w;
     size_t pos = 0u, i, sz;
@@ -362,6 +371,8 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             fashionstar_uart__put(out + pos, e->size, e->big, code);
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
             fashionstar_uart__put(out + pos, e->size, e->big, values[v++]);
+        } else if (FASHIONSTAR_UART__OPTIONAL && e->role == FASHIONSTAR_UART__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != FASHIONSTAR_UART__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -370,6 +381,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
@@ -467,7 +479,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
             *code = fashionstar_uart__get(bytes, e->size, e->big);
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
             uint32_t value = fashionstar_uart__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(FASHIONSTAR_UART__PLAUSIBLE(e, value))) {
                 return FASHIONSTAR_UART_E_RANGE;
             }
             values[v++] = value;
@@ -538,7 +550,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
             }
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
             uint32_t value = fashionstar_uart__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(FASHIONSTAR_UART__PLAUSIBLE(e, value))) {
                 return FASHIONSTAR_UART__NONE;
             }
         }
@@ -1013,6 +1025,7 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
     return FASHIONSTAR_UART_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
@@ -2402,22 +2415,27 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     }
     k = 0u;
     if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = fashionstar_uart__header(dir, k, &hl);
             if (hl <= len && fashionstar_uart__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return FASHIONSTAR_UART_E_FRAME;
+            return headed ? FASHIONSTAR_UART_E_LENGTH : FASHIONSTAR_UART_E_FRAME;
         }
     }
     r = fashionstar_uart__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != FASHIONSTAR_UART_OK) {
         return r;
     }
-    r = fashionstar_uart__decode_content(dir, fashionstar_uart__has_command(dir, k) ? (long)code : FASHIONSTAR_UART__NO_CODE, expect, c, clen, values, out);
+    r = fashionstar_uart__decode_content(dir, fashionstar_uart__has_command(dir, k) ? (long)code : FASHIONSTAR_UART__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != FASHIONSTAR_UART_OK) {
         out->kind = FASHIONSTAR_UART_KIND_NONE;
     }
@@ -3779,8 +3797,8 @@ static int fashionstar_uart__enc_sync_command_request(const void *mv, uint8_t *c
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t code, const uint32_t *values, const void *m, fashionstar_uart__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      fashionstar_uart__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
@@ -3810,7 +3828,7 @@ static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t co
         }
         r = enc(m, dst, room, &clen);
         if (r == FASHIONSTAR_UART_OK) {
-            r = fashionstar_uart__wrap(L, buf, cap, span, clen, code, values, len);
+            r = fashionstar_uart__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == FASHIONSTAR_UART_OK) {
             return r;

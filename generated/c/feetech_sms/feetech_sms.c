@@ -35,6 +35,8 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define FEETECH_SMS__RX(dir) (dir)
 #endif
+#define FEETECH_SMS__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define FEETECH_SMS__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum inverted. */
@@ -67,6 +69,13 @@ static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
 #define FEETECH_SMS__ROLE_LENGTH 3u
 #define FEETECH_SMS__ROLE_CONTENT 4u
 #define FEETECH_SMS__ROLE_CHECKSUM 5u
+#define FEETECH_SMS__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define FEETECH_SMS__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!FEETECH_SMS__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -90,7 +99,7 @@ typedef struct {
     uint8_t role;     /* FEETECH_SMS__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (feetech_sms__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -285,7 +294,7 @@ static const uint8_t *feetech_sms__range(const feetech_sms__layout_t *L, const f
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     feetech_sms__where_t w;
     size_t pos = 0u, i, sz;
@@ -362,6 +371,8 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             feetech_sms__put(out + pos, e->size, e->big, code);
         } else if (e->role == FEETECH_SMS__ROLE_VALUE) {
             feetech_sms__put(out + pos, e->size, e->big, values[v++]);
+        } else if (FEETECH_SMS__OPTIONAL && e->role == FEETECH_SMS__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != FEETECH_SMS__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -370,6 +381,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
@@ -467,7 +479,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
             *code = feetech_sms__get(bytes, e->size, e->big);
         } else if (e->role == FEETECH_SMS__ROLE_VALUE) {
             uint32_t value = feetech_sms__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(FEETECH_SMS__PLAUSIBLE(e, value))) {
                 return FEETECH_SMS_E_RANGE;
             }
             values[v++] = value;
@@ -538,7 +550,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
             }
         } else if (e->role == FEETECH_SMS__ROLE_VALUE) {
             uint32_t value = feetech_sms__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(FEETECH_SMS__PLAUSIBLE(e, value))) {
                 return FEETECH_SMS__NONE;
             }
         }
@@ -869,6 +881,7 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
 #endif
 }
 
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int feetech_sms__dec_ping_request(const uint8_t *c, size_t n, feetech_sms_ping_request_t *m)
@@ -1125,22 +1138,27 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     }
     k = 0u;
     if (!FEETECH_SMS__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = feetech_sms__header(dir, k, &hl);
             if (hl <= len && feetech_sms__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return FEETECH_SMS_E_FRAME;
+            return headed ? FEETECH_SMS_E_LENGTH : FEETECH_SMS_E_FRAME;
         }
     }
     r = feetech_sms__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != FEETECH_SMS_OK) {
         return r;
     }
-    r = feetech_sms__decode_content(dir, feetech_sms__has_command(dir, k) ? (long)code : FEETECH_SMS__NO_CODE, expect, c, clen, values, out);
+    r = feetech_sms__decode_content(dir, feetech_sms__has_command(dir, k) ? (long)code : FEETECH_SMS__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != FEETECH_SMS_OK) {
         out->kind = FEETECH_SMS_KIND_NONE;
     }
@@ -1345,8 +1363,8 @@ static int feetech_sms__enc_reply_response(const void *mv, uint8_t *c, size_t ca
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int feetech_sms__frame(feetech_sms_direction_t dir, uint32_t code, const uint32_t *values, const void *m, feetech_sms__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int feetech_sms__frame(feetech_sms_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      feetech_sms__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
@@ -1376,7 +1394,7 @@ static int feetech_sms__frame(feetech_sms_direction_t dir, uint32_t code, const 
         }
         r = enc(m, dst, room, &clen);
         if (r == FEETECH_SMS_OK) {
-            r = feetech_sms__wrap(L, buf, cap, span, clen, code, values, len);
+            r = feetech_sms__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == FEETECH_SMS_OK) {
             return r;

@@ -35,6 +35,8 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define HIWONDER_RRC__RX(dir) (dir)
 #endif
+#define HIWONDER_RRC__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define HIWONDER_RRC__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -71,6 +73,13 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 #define HIWONDER_RRC__ROLE_LENGTH 3u
 #define HIWONDER_RRC__ROLE_CONTENT 4u
 #define HIWONDER_RRC__ROLE_CHECKSUM 5u
+#define HIWONDER_RRC__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define HIWONDER_RRC__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!HIWONDER_RRC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -94,7 +103,7 @@ typedef struct {
     uint8_t role;     /* HIWONDER_RRC__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (hiwonder_rrc__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -289,7 +298,7 @@ static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     hiwonder_rrc__where_t w;
     size_t pos = 0u, i, sz;
@@ -366,6 +375,8 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
             hiwonder_rrc__put(out + pos, e->size, e->big, code);
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
             hiwonder_rrc__put(out + pos, e->size, e->big, values[v++]);
+        } else if (HIWONDER_RRC__OPTIONAL && e->role == HIWONDER_RRC__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != HIWONDER_RRC__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -374,6 +385,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
@@ -471,7 +483,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
             *code = hiwonder_rrc__get(bytes, e->size, e->big);
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
             uint32_t value = hiwonder_rrc__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(HIWONDER_RRC__PLAUSIBLE(e, value))) {
                 return HIWONDER_RRC_E_RANGE;
             }
             values[v++] = value;
@@ -542,7 +554,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             }
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
             uint32_t value = hiwonder_rrc__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(HIWONDER_RRC__PLAUSIBLE(e, value))) {
                 return HIWONDER_RRC__NONE;
             }
         }
@@ -929,6 +941,7 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
     return HIWONDER_RRC_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of led (request): fields in wire order. */
@@ -2321,22 +2334,27 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     }
     k = 0u;
     if (!HIWONDER_RRC__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = hiwonder_rrc__header(dir, k, &hl);
             if (hl <= len && hiwonder_rrc__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return HIWONDER_RRC_E_FRAME;
+            return headed ? HIWONDER_RRC_E_LENGTH : HIWONDER_RRC_E_FRAME;
         }
     }
     r = hiwonder_rrc__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != HIWONDER_RRC_OK) {
         return r;
     }
-    r = hiwonder_rrc__decode_content(dir, hiwonder_rrc__has_command(dir, k) ? (long)code : HIWONDER_RRC__NO_CODE, expect, c, clen, values, out);
+    r = hiwonder_rrc__decode_content(dir, hiwonder_rrc__has_command(dir, k) ? (long)code : HIWONDER_RRC__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != HIWONDER_RRC_OK) {
         out->kind = HIWONDER_RRC_KIND_NONE;
     }
@@ -3564,8 +3582,8 @@ static int hiwonder_rrc__enc_rgb_set_pixels_request(const void *mv, uint8_t *c, 
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, const uint32_t *values, const void *m, hiwonder_rrc__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      hiwonder_rrc__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
@@ -3595,7 +3613,7 @@ static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, cons
         }
         r = enc(m, dst, room, &clen);
         if (r == HIWONDER_RRC_OK) {
-            r = hiwonder_rrc__wrap(L, buf, cap, span, clen, code, values, len);
+            r = hiwonder_rrc__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == HIWONDER_RRC_OK) {
             return r;

@@ -35,6 +35,8 @@ typedef char modbus_ascii__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define MODBUS_ASCII__RX(dir) (dir)
 #endif
+#define MODBUS_ASCII__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define MODBUS_ASCII__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum negated. */
@@ -67,6 +69,13 @@ static uint32_t modbus_ascii__check(uint8_t which, const uint8_t *d, size_t n)
 #define MODBUS_ASCII__ROLE_LENGTH 3u
 #define MODBUS_ASCII__ROLE_CONTENT 4u
 #define MODBUS_ASCII__ROLE_CHECKSUM 5u
+#define MODBUS_ASCII__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define MODBUS_ASCII__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!MODBUS_ASCII__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_ascii__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -90,7 +99,7 @@ typedef struct {
     uint8_t role;     /* MODBUS_ASCII__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (modbus_ascii__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -347,7 +356,7 @@ static const uint8_t *modbus_ascii__range(const modbus_ascii__layout_t *L, const
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     modbus_ascii__where_t w;
     size_t pos = 0u, i, sz;
@@ -424,6 +433,8 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             modbus_ascii__put(out + pos, e->size, e->big, code);
         } else if (e->role == MODBUS_ASCII__ROLE_VALUE) {
             modbus_ascii__put(out + pos, e->size, e->big, values[v++]);
+        } else if (MODBUS_ASCII__OPTIONAL && e->role == MODBUS_ASCII__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != MODBUS_ASCII__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -432,6 +443,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_ascii__element_t *e = &L->e[k];
@@ -529,7 +541,7 @@ static int modbus_ascii__unwrap(const modbus_ascii__layout_t *L, const uint8_t *
             *code = modbus_ascii__get(bytes, e->size, e->big);
         } else if (e->role == MODBUS_ASCII__ROLE_VALUE) {
             uint32_t value = modbus_ascii__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(MODBUS_ASCII__PLAUSIBLE(e, value))) {
                 return MODBUS_ASCII_E_RANGE;
             }
             values[v++] = value;
@@ -600,7 +612,7 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
             }
         } else if (e->role == MODBUS_ASCII__ROLE_VALUE) {
             uint32_t value = modbus_ascii__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(MODBUS_ASCII__PLAUSIBLE(e, value))) {
                 return MODBUS_ASCII__NONE;
             }
         }
@@ -980,6 +992,7 @@ static int modbus_ascii__unwrap_at(modbus_ascii_direction_t dir, uint8_t k, cons
     return MODBUS_ASCII_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of read_coils (request): fields in wire order. */
@@ -1605,22 +1618,27 @@ int modbus_ascii_decode_expect(const uint8_t *frame, size_t len, modbus_ascii_di
     }
     k = 0u;
     if (!MODBUS_ASCII__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = modbus_ascii__header(dir, k, &hl);
             if (hl <= len && modbus_ascii__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return MODBUS_ASCII_E_FRAME;
+            return headed ? MODBUS_ASCII_E_LENGTH : MODBUS_ASCII_E_FRAME;
         }
     }
     r = modbus_ascii__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != MODBUS_ASCII_OK) {
         return r;
     }
-    r = modbus_ascii__decode_content(dir, modbus_ascii__has_command(dir, k) ? (long)code : MODBUS_ASCII__NO_CODE, expect, c, clen, values, out);
+    r = modbus_ascii__decode_content(dir, modbus_ascii__has_command(dir, k) ? (long)code : MODBUS_ASCII__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != MODBUS_ASCII_OK) {
         out->kind = MODBUS_ASCII_KIND_NONE;
     }
@@ -2144,8 +2162,8 @@ static int modbus_ascii__enc_exception_response(const void *mv, uint8_t *c, size
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int modbus_ascii__frame(modbus_ascii_direction_t dir, uint32_t code, const uint32_t *values, const void *m, modbus_ascii__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int modbus_ascii__frame(modbus_ascii_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      modbus_ascii__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const modbus_ascii__layout_t *const *layouts = modbus_ascii__layouts(dir, &count);
@@ -2175,7 +2193,7 @@ static int modbus_ascii__frame(modbus_ascii_direction_t dir, uint32_t code, cons
         }
         r = enc(m, dst, room, &clen);
         if (r == MODBUS_ASCII_OK) {
-            r = modbus_ascii__wrap(L, buf, cap, span, clen, code, values, len);
+            r = modbus_ascii__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == MODBUS_ASCII_OK) {
             return r;

@@ -35,6 +35,8 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define MODBUS_RTU__RX(dir) (dir)
 #endif
+#define MODBUS_RTU__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define MODBUS_RTU__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffff, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -71,6 +73,13 @@ static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
 #define MODBUS_RTU__ROLE_LENGTH 3u
 #define MODBUS_RTU__ROLE_CONTENT 4u
 #define MODBUS_RTU__ROLE_CHECKSUM 5u
+#define MODBUS_RTU__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define MODBUS_RTU__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!MODBUS_RTU__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -94,7 +103,7 @@ typedef struct {
     uint8_t role;     /* MODBUS_RTU__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (modbus_rtu__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -289,7 +298,7 @@ static const uint8_t *modbus_rtu__range(const modbus_rtu__layout_t *L, const mod
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     modbus_rtu__where_t w;
     size_t pos = 0u, i, sz;
@@ -366,6 +375,8 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             modbus_rtu__put(out + pos, e->size, e->big, code);
         } else if (e->role == MODBUS_RTU__ROLE_VALUE) {
             modbus_rtu__put(out + pos, e->size, e->big, values[v++]);
+        } else if (MODBUS_RTU__OPTIONAL && e->role == MODBUS_RTU__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != MODBUS_RTU__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -374,6 +385,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
@@ -471,7 +483,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
             *code = modbus_rtu__get(bytes, e->size, e->big);
         } else if (e->role == MODBUS_RTU__ROLE_VALUE) {
             uint32_t value = modbus_rtu__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(MODBUS_RTU__PLAUSIBLE(e, value))) {
                 return MODBUS_RTU_E_RANGE;
             }
             values[v++] = value;
@@ -542,7 +554,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
             }
         } else if (e->role == MODBUS_RTU__ROLE_VALUE) {
             uint32_t value = modbus_rtu__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(MODBUS_RTU__PLAUSIBLE(e, value))) {
                 return MODBUS_RTU__NONE;
             }
         }
@@ -1005,6 +1017,7 @@ static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const ui
     return MODBUS_RTU_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of read_coils (request): fields in wire order. */
@@ -1630,22 +1643,27 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     }
     k = 0u;
     if (!MODBUS_RTU__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = modbus_rtu__header(dir, k, &hl);
             if (hl <= len && modbus_rtu__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return MODBUS_RTU_E_FRAME;
+            return headed ? MODBUS_RTU_E_LENGTH : MODBUS_RTU_E_FRAME;
         }
     }
     r = modbus_rtu__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != MODBUS_RTU_OK) {
         return r;
     }
-    r = modbus_rtu__decode_content(dir, modbus_rtu__has_command(dir, k) ? (long)code : MODBUS_RTU__NO_CODE, expect, c, clen, values, out);
+    r = modbus_rtu__decode_content(dir, modbus_rtu__has_command(dir, k) ? (long)code : MODBUS_RTU__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != MODBUS_RTU_OK) {
         out->kind = MODBUS_RTU_KIND_NONE;
     }
@@ -2169,8 +2187,8 @@ static int modbus_rtu__enc_exception_response(const void *mv, uint8_t *c, size_t
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int modbus_rtu__frame(modbus_rtu_direction_t dir, uint32_t code, const uint32_t *values, const void *m, modbus_rtu__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int modbus_rtu__frame(modbus_rtu_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      modbus_rtu__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
@@ -2200,7 +2218,7 @@ static int modbus_rtu__frame(modbus_rtu_direction_t dir, uint32_t code, const ui
         }
         r = enc(m, dst, room, &clen);
         if (r == MODBUS_RTU_OK) {
-            r = modbus_rtu__wrap(L, buf, cap, span, clen, code, values, len);
+            r = modbus_rtu__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == MODBUS_RTU_OK) {
             return r;

@@ -35,6 +35,8 @@ typedef char ubx__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define UBX__RX(dir) (dir)
 #endif
+#define UBX__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define UBX__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* Fletcher modulo 256: CK_A the sum of the bytes, CK_B the sum of CK_A after each byte; the value is
@@ -69,6 +71,13 @@ static uint32_t ubx__check(uint8_t which, const uint8_t *d, size_t n)
 #define UBX__ROLE_LENGTH 3u
 #define UBX__ROLE_CONTENT 4u
 #define UBX__ROLE_CHECKSUM 5u
+#define UBX__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define UBX__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!UBX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int ubx__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -92,7 +101,7 @@ typedef struct {
     uint8_t role;     /* UBX__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (ubx__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -287,7 +296,7 @@ static const uint8_t *ubx__range(const ubx__layout_t *L, const ubx__where_t *w, 
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     ubx__where_t w;
     size_t pos = 0u, i, sz;
@@ -364,6 +373,8 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             ubx__put(out + pos, e->size, e->big, code);
         } else if (e->role == UBX__ROLE_VALUE) {
             ubx__put(out + pos, e->size, e->big, values[v++]);
+        } else if (UBX__OPTIONAL && e->role == UBX__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != UBX__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -372,6 +383,7 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const ubx__element_t *e = &L->e[k];
@@ -469,7 +481,7 @@ static int ubx__unwrap(const ubx__layout_t *L, const uint8_t *frame, size_t n, u
             *code = ubx__get(bytes, e->size, e->big);
         } else if (e->role == UBX__ROLE_VALUE) {
             uint32_t value = ubx__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(UBX__PLAUSIBLE(e, value))) {
                 return UBX_E_RANGE;
             }
             values[v++] = value;
@@ -540,7 +552,7 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
             }
         } else if (e->role == UBX__ROLE_VALUE) {
             uint32_t value = ubx__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(UBX__PLAUSIBLE(e, value))) {
                 return UBX__NONE;
             }
         }
@@ -1023,6 +1035,7 @@ static int ubx__unwrap_at(ubx_direction_t dir, uint8_t k, const uint8_t *frame, 
     return UBX_E_ARG;
 #endif
 }
+
 
 /* ---- content decoders ---- */
 /* The content of nav_status (request): fields in wire order. */
@@ -1560,22 +1573,27 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
     }
     k = 0u;
     if (!UBX__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = ubx__header(dir, k, &hl);
             if (hl <= len && ubx__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return UBX_E_FRAME;
+            return headed ? UBX_E_LENGTH : UBX_E_FRAME;
         }
     }
     r = ubx__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != UBX_OK) {
         return r;
     }
-    r = ubx__decode_content(dir, ubx__has_command(dir, k) ? (long)code : UBX__NO_CODE, expect, c, clen, values, out);
+    r = ubx__decode_content(dir, ubx__has_command(dir, k) ? (long)code : UBX__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != UBX_OK) {
         out->kind = UBX_KIND_NONE;
     }
@@ -2009,8 +2027,8 @@ static int ubx__enc_mon_ver_response(const void *mv, uint8_t *c, size_t cap, siz
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int ubx__frame(ubx_direction_t dir, uint32_t code, const uint32_t *values, const void *m, ubx__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int ubx__frame(ubx_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      ubx__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const ubx__layout_t *const *layouts = ubx__layouts(dir, &count);
@@ -2040,7 +2058,7 @@ static int ubx__frame(ubx_direction_t dir, uint32_t code, const uint32_t *values
         }
         r = enc(m, dst, room, &clen);
         if (r == UBX_OK) {
-            r = ubx__wrap(L, buf, cap, span, clen, code, values, len);
+            r = ubx__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == UBX_OK) {
             return r;

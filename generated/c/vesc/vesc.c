@@ -35,6 +35,8 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define VESC__RX(dir) (dir)
 #endif
+#define VESC__OPTIONAL 0 /* some layout has optional elements (`present_if`): its variants are layouts */
+#define VESC__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 /* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -71,6 +73,13 @@ static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
 #define VESC__ROLE_LENGTH 3u
 #define VESC__ROLE_CONTENT 4u
 #define VESC__ROLE_CHECKSUM 5u
+#define VESC__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define VESC__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!VESC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -94,7 +103,7 @@ typedef struct {
     uint8_t role;     /* VESC__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (vesc__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -289,7 +298,7 @@ static const uint8_t *vesc__range(const vesc__layout_t *L, const vesc__where_t *
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     vesc__where_t w;
     size_t pos = 0u, i, sz;
@@ -366,6 +375,8 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             vesc__put(out + pos, e->size, e->big, code);
         } else if (e->role == VESC__ROLE_VALUE) {
             vesc__put(out + pos, e->size, e->big, values[v++]);
+        } else if (VESC__OPTIONAL && e->role == VESC__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != VESC__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -374,6 +385,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
@@ -471,7 +483,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
             *code = vesc__get(bytes, e->size, e->big);
         } else if (e->role == VESC__ROLE_VALUE) {
             uint32_t value = vesc__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(VESC__PLAUSIBLE(e, value))) {
                 return VESC_E_RANGE;
             }
             values[v++] = value;
@@ -542,7 +554,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
             }
         } else if (e->role == VESC__ROLE_VALUE) {
             uint32_t value = vesc__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(VESC__PLAUSIBLE(e, value))) {
                 return VESC__NONE;
             }
         }
@@ -1156,6 +1168,7 @@ static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const uint8_t *frame
 #endif
 }
 
+
 /* ---- content decoders ---- */
 /* The content of fw_version (request): fields in wire order. */
 static int vesc__dec_fw_version_request(const uint8_t *c, size_t n, vesc_fw_version_request_t *m)
@@ -1611,22 +1624,27 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     }
     k = 0u;
     if (!VESC__SINGLE && count != 1u) {
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {
             size_t hl;
             const uint8_t *h = vesc__header(dir, k, &hl);
             if (hl <= len && vesc__same(frame, h, hl)) {
-                break;
+                headed = 1;
+                if (1) {
+                    break;
+                }
             }
         }
         if (k == count) {
-            return VESC_E_FRAME;
+            return headed ? VESC_E_LENGTH : VESC_E_FRAME;
         }
     }
     r = vesc__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != VESC_OK) {
         return r;
     }
-    r = vesc__decode_content(dir, vesc__has_command(dir, k) ? (long)code : VESC__NO_CODE, expect, c, clen, values, out);
+    r = vesc__decode_content(dir, vesc__has_command(dir, k) ? (long)code : VESC__NO_CODE, expect, c, clen, values,
+                            out);
     if (r != VESC_OK) {
         out->kind = VESC_KIND_NONE;
     }
@@ -1983,8 +2001,8 @@ static int vesc__enc_forward_can_request(const void *mv, uint8_t *c, size_t cap,
 
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int vesc__frame(vesc_direction_t dir, uint32_t code, const uint32_t *values, const void *m, vesc__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int vesc__frame(vesc_direction_t dir, uint32_t code, const uint32_t *values, const void *m,
+                      vesc__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {
     uint8_t count, k, i;
     const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
@@ -2014,7 +2032,7 @@ static int vesc__frame(vesc_direction_t dir, uint32_t code, const uint32_t *valu
         }
         r = enc(m, dst, room, &clen);
         if (r == VESC_OK) {
-            r = vesc__wrap(L, buf, cap, span, clen, code, values, len);
+            r = vesc__wrap(L, buf, cap, span, clen, code, values, NULL, len);
         }
         if (r == VESC_OK) {
             return r;

@@ -842,7 +842,9 @@ FRAME_ELEMENT = Obj(
             "value, and a message whose value and bytes disagree is refused before a byte is written. It lies "
             "outside every length's and checksum's span and outside the transparency span (MAVLink v2: "
             '`signature: {role: optional, size: 13, present_if: "incompat_flags & 0x01"}` after the CRC; a '
-            "receiver that knows the secret key checks it).",
+            "receiver that knows the secret key checks it). In C, every message struct of the direction has "
+            "`bool has_<name>` and `uint8_t <name>[size]`, and the C refuses a disagreeing value flag with "
+            "`P_E_RANGE`.",
             example="incompat_flags & 0x01",
         ),
         "truncate": Str(

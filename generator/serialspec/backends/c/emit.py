@@ -13,7 +13,7 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import assert_never
+from typing import Any, assert_never
 
 from serialspec.backends import Unsupported
 from serialspec.backends.c import packed
@@ -165,6 +165,20 @@ class Ctx:
     caps: list[str] = field(default_factory=list)  # #ifndef capacity defaults for the header
     structs: list[str] = field(default_factory=list)
     helpers: set[str] = field(default_factory=set)
+    cap_defaults: dict[str, int] = field(default_factory=dict)  # capacity macro -> its default
+    json_writers: set[str] = field(default_factory=set)  # the JSON writer functions called (wu, wi, wf, ...)
+
+    def writer(self, name: str) -> str:
+        """The JSON writer function `name` (p__wu, p__wbytes, ...), which its file then defines."""
+        self.json_writers.add(name)
+        return f"{self.p}__{name}"
+
+    struct_members: dict[str, list[Any]] = field(default_factory=dict)  # item and block struct -> its Members
+    message_members: dict[str, list[Any]] = field(default_factory=dict)  # message id -> its struct's Members
+    # a spec with optional frame elements: the spec itself (`protocol` has the plain variants of its layouts in their
+    # place) and each direction's variants (optional.py)
+    original: Protocol | None = None
+    variants: dict[Direction, tuple[Any, ...]] = field(default_factory=dict)
 
     def check_index(self, checksum: Checksum) -> int:
         for i, (known, _) in enumerate(self.checks):
@@ -210,8 +224,6 @@ def refuse_layout(layout: FrameLayout) -> None:
     for e in elements:
         if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
             raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
-    if layout.optional:
-        raise Unsupported(f"{where}: an optional element ({layout.optional[0].name}, `present_if`)")
     t = layout.transparency
     if t is not None and t.transform.c_refusal():
         raise Unsupported(f"{where}: {t.transform.c_refusal()}")
@@ -322,11 +334,14 @@ class Member:
     name: str
     decl: str
     doc: str
+    ctype: str = ""  # its C type (of one item, for an array), and how many: a number or a capacity macro (+ 1 for
+    count: int | str = 1  # a text's NUL); what readme.py sizes the structs from
 
 
 def cap_macro(ctx: Ctx, path: str, default: int) -> str:
     macro = f"{ctx.P}_{path.upper()}_MAX"
     ctx.caps.append(f"#ifndef {macro}\n#define {macro} {default}u\n#endif")
+    ctx.cap_defaults[macro] = default
     return macro
 
 
@@ -356,21 +371,23 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
         match f:
             case Scalar():
                 if not f.hidden:
-                    found.append(Member(name, f"{ctype(value_type(f))} {name};", doc))
+                    t = ctype(value_type(f))
+                    found.append(Member(name, f"{t} {name};", doc, t))
             case Array():
-                found.append(Member(name, f"{ctype(f.item)} {name}[{f.count}];", doc))
+                found.append(Member(name, f"{ctype(f.item)} {name}[{f.count}];", doc, ctype(f.item), f.count))
             case Bytes():
                 if isinstance(f.size, int):
-                    found.append(Member(name, f"uint8_t {name}[{f.size}];", doc))
+                    found.append(Member(name, f"uint8_t {name}[{f.size}];", doc, "uint8_t", f.size))
                 else:
                     macro = cap_macro(ctx, f"{path}_{f.name}", min(room, DEFAULT_MAX_BYTES))
-                    found.append(Member(name, f"uint8_t {name}[{macro}];", doc))
-                    found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes in {f.name}"))
+                    found.append(Member(name, f"uint8_t {name}[{macro}];", doc, "uint8_t", macro))
+                    found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes in {f.name}", "size_t"))
             case Text():
                 size = f.size if isinstance(f.size, int) else min(room, DEFAULT_MAX_BYTES)
                 macro = cap_macro(ctx, f"{path}_{f.name}", size)
-                found.append(Member(name, f"char {name}[{macro} + 1u];", doc + "; UTF-8, NUL-terminated here"))
-                found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes of text in {f.name}"))
+                text_doc = doc + "; UTF-8, NUL-terminated here"
+                found.append(Member(name, f"char {name}[{macro} + 1u];", text_doc, "char", f"{macro} + 1"))
+                found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes of text in {f.name}", "size_t"))
             case Group():
                 item = f"{ctx.p}_{path}_{f.name}_item_t"
                 inner = members(ctx, f.fields, f"{path}_{f.name}", room)
@@ -378,17 +395,17 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                 ctx.structs.append(
                     f"/* One item of {f.name}. */\ntypedef struct {{\n{body or '    uint8_t unused_;'}\n}} {item};\n"
                 )
+                ctx.struct_members[item] = inner or [Member("unused_", "uint8_t unused_;", "", "uint8_t")]
                 if isinstance(f.count, int):
-                    found.append(Member(name, f"{item} {name}[{f.count}];", doc))
+                    found.append(Member(name, f"{item} {name}[{f.count}];", doc, item, f.count))
                 else:
                     size = f.item_size or 1
                     macro = cap_macro(ctx, f"{path}_{f.name}", max(1, min(room // size, DEFAULT_MAX_ITEMS)))
-                    found.append(Member(name, f"{item} {name}[{macro}];", doc))
-                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+                    found.append(Member(name, f"{item} {name}[{macro}];", doc, item, macro))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}", "size_t"))
             case TableValue():
-                found.append(
-                    Member(name, f"int64_t {name};", doc + f"; its type is the {f.table.name} entry {f.key} names")
-                )
+                table_doc = doc + f"; its type is the {f.table.name} entry {f.key} names"
+                found.append(Member(name, f"int64_t {name};", table_doc, "int64_t"))
             case TableBlock():
                 block = f"{ctx.p}_{path}_{f.name}_t"
                 body = "\n".join(
@@ -396,19 +413,22 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     for e in f.entries
                 )
                 ctx.structs.append(f"/* {comment(f.description)} */\ntypedef struct {{\n{body}\n}} {block};\n")
-                found.append(Member(name, f"{block} {name};", doc))
+                ctx.struct_members[block] = [Member(ident(e.name), "", e.description, ctype(e.type)) for e in f.entries]
+                found.append(Member(name, f"{block} {name};", doc, block))
             case List():
                 if f.item is None:  # bits, 8 to a byte, the first in the lowest bit (as on the wire)
                     macro = cap_macro(ctx, f"{path}_{f.name}", max(1, min(room, DEFAULT_MAX_BYTES)))
-                    found.append(Member(name, f"uint8_t {name}[{macro}];", doc + "; bits, 8 to a byte"))
-                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"bits in {f.name}"))
+                    bits_doc = doc + "; bits, 8 to a byte"
+                    found.append(Member(name, f"uint8_t {name}[{macro}];", bits_doc, "uint8_t", macro))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"bits in {f.name}", "size_t"))
                 else:
                     most = max(1, min(room // f.item.size, DEFAULT_MAX_BYTES))
                     macro = cap_macro(ctx, f"{path}_{f.name}", most)
-                    found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
-                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+                    found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc, ctype(f.item), macro))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}", "size_t"))
             case Packed():
-                found.append(Member(name, f"{ctype(packed.item_type(f))} {name}[{f.count}];", doc))
+                t = ctype(packed.item_type(f))
+                found.append(Member(name, f"{t} {name}[{f.count}];", doc, t, f.count))
             case _:
                 assert_never(f)
     return found
@@ -446,6 +466,7 @@ def get_raw(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
     if wide(t):
         ctx.helpers.add("get64")
         return f"{ctx.p}__get64({at}, {1 if endian == '>' else 0}u)"
+    ctx.helpers.add("get")
     return f"{ctx.p}__get({at}, {t.size}u, {1 if endian == '>' else 0}u)"
 
 
@@ -493,7 +514,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     top = 1 << (8 * size - 1)
                     raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
                     value = f"{ctx.p}__sm({raw}, 0x{top:x}UL)"
-                    ctx.helpers.add("sm")
+                    ctx.helpers |= {"sm", "get"}
                 if f.const is not None:
                     out.append(
                         f"{pad}if ({get_raw(ctx, f.type, f.endian, 'c + o')} != "
@@ -1295,9 +1316,9 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
             case Bytes():
                 length = f"{f.size}u" if isinstance(f.size, int) else f"{tgt}_len"
-                out.append(f"{pad}{ctx.p}__wbytes(w, {tgt}, {length});")
+                out.append(f"{pad}{ctx.writer('wbytes')}(w, {tgt}, {length});")
             case Text():
-                out.append(f"{pad}{ctx.p}__wtext(w, {tgt}, {tgt}_len);")
+                out.append(f"{pad}{ctx.writer('wtext')}(w, {tgt}, {tgt}_len);")
             case Group():
                 i = f"i{depth}"
                 count = f"{f.count}u" if isinstance(f.count, int) else f"{tgt}_count"
@@ -1310,8 +1331,8 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
             case TableValue():
                 out.append(
-                    f"{pad}if ({tgt} < 0) {{ {ctx.p}__wi(w, (int32_t){tgt}); }} "
-                    f"else {{ {ctx.p}__wu(w, (uint32_t){tgt}); }}"
+                    f"{pad}if ({tgt} < 0) {{ {ctx.writer('wi')}(w, (int32_t){tgt}); }} "
+                    f"else {{ {ctx.writer('wu')}(w, (uint32_t){tgt}); }}"
                 )
             case TableBlock():
                 out.append(f'{pad}{ctx.p}__ws(w, "{{");')
@@ -1350,19 +1371,19 @@ def json_bits(ctx: Ctx, bits: tuple[BitField, ...], value: str, out: list[str], 
         s = "" if k == 0 else ", "
         out.append(
             f'{pad}{ctx.p}__ws(w, "{s}\\"{b.name}\\": "); '
-            f"{ctx.p}__wu(w, ((uint32_t){value} >> {b.low}) & 0x{b.mask:x}u);"
+            f"{ctx.writer('wu')}(w, ((uint32_t){value} >> {b.low}) & 0x{b.mask:x}u);"
         )
     out.append(f'{pad}{ctx.p}__ws(w, "}}");')
 
 
 def json_number(ctx: Ctx, t: ScalarType, expr: str) -> str:
     if t.is_float:
-        return f"{ctx.p}__wf(w, (double){expr});"
+        return f"{ctx.writer('wf')}(w, (double){expr});"
     if wide(t):
-        return f"{ctx.p}__w{'i' if t.signed else 'u'}64(w, {expr});"
+        return f"{ctx.writer('wi64' if t.signed else 'wu64')}(w, {expr});"
     if t.signed:
-        return f"{ctx.p}__wi(w, (int32_t){expr});"
-    return f"{ctx.p}__wu(w, (uint32_t){expr});"
+        return f"{ctx.writer('wi')}(w, (int32_t){expr});"
+    return f"{ctx.writer('wu')}(w, (uint32_t){expr});"
 
 
 def json_function(ctx: Ctx, message: Message) -> str:
@@ -1377,13 +1398,17 @@ def json_function(ctx: Ctx, message: Message) -> str:
         if e.bits:
             json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
         else:
-            body.append(f"    {ctx.p}__wu(w, (uint32_t)m->{ident(e.name)});")
+            body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(e.name)});")
     error = ctx.protocol.error_reply
     if message.error_reply and error is not None:
         body.append(f'    {ctx.p}__ws(w, "{"" if first else ", "}\\"{error.element}\\": ");')
-        body.append(f"    {ctx.p}__wu(w, (uint32_t)m->{ident(error.element)});")
+        body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(error.element)});")
         first = False
-    json_fields(ctx, message.fields, "m->", body, 1, first)
+    first = json_fields(ctx, message.fields, "m->", body, 1, first)
+    if ctx.original is not None:  # optional frame elements, after every field (as the Python message's to_fields)
+        from serialspec.backends.c.optional import json_lines
+
+        body += json_lines(ctx, message.direction, first)
     text = "\n".join(body)
     locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
     return "\n".join(
@@ -1417,30 +1442,30 @@ def files(protocol: Protocol) -> dict[str, str]:
 
         return text.files(protocol, protocol.text)
     refuse_unsupported(protocol)
-    ctx = Ctx(protocol, protocol.name, protocol.name.upper())
+    from serialspec.backends.c.optional import expanded
+
+    spec = protocol
+    protocol, variants = expanded(spec)  # optional elements: each layout's plain variants in its place
+    ctx = Ctx(protocol, protocol.name, protocol.name.upper(), original=spec if protocol is not spec else None)
+    ctx.variants = variants
     for layouts in protocol.framing.alternatives.values():  # the checksums first: the header declares them
         for layout in layouts:
             for e in layout.elements:
                 if e.checksum is not None:
                     ctx.check_index(e.checksum)
     from serialspec.backends.c.files import header, json_header, json_source, source
+    from serialspec.backends.c.readme import readme
     from serialspec.backends.c.vectors import check_vectors, vectors_header
 
     p = protocol.name
     h = header(ctx)
     c = source(ctx)
-    from serialspec.backends.c.engine import ENGINE
-
-    stuffed = any(layout.transparency for layouts in protocol.framing.alternatives.values() for layout in layouts)
-    if not stuffed and c.count(f"{p}__get(") == ENGINE.count("pfx__get("):
-        # read only by the engine's code for stuffed layouts, which this spec leaves out (fields of 8 bytes or packed)
-        start = c.index(f"static uint32_t {p}__get(")
-        c = c[:start] + c[c.index("\n}\n", start) + 3 :].lstrip("\n")
     return {
         f"{p}/{p}.h": h,
         f"{p}/{p}.c": c,
         f"{p}/{p}_json.h": json_header(ctx),
         f"{p}/{p}_json.c": json_source(ctx),
+        f"{p}/README.md": readme(ctx),
         f"{p}/test/vectors.h": vectors_header(ctx),
         f"{p}/test/check_vectors.c": check_vectors(ctx),
     }

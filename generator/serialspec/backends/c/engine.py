@@ -1,7 +1,7 @@
 """The frame engine every generated .c carries: the spec's layouts as tables, walked by code that follows
 serialspec.runtime.framing (Layout.wrap, Layout.unwrap, FrameCodec.probe). PFX_/pfx_ stand for the protocol's prefix."""
 
-ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
+HEAD = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
 
 #define PFX__ROLE_CONSTANT 0u
 #define PFX__ROLE_VALUE 1u
@@ -9,6 +9,13 @@ ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/fra
 #define PFX__ROLE_LENGTH 3u
 #define PFX__ROLE_CONTENT 4u
 #define PFX__ROLE_CHECKSUM 5u
+#define PFX__ROLE_EXTRA 6u /* an optional element sent: fixed bytes the message gives (a layout's variant) */
+
+/* A value in range (and, in a variant of a layout with optional elements, with the flag bit the variant has:
+ * first = the bit's number + 1, last = 1 set / 0 clear). */
+#define PFX__PLAUSIBLE(e, value) \
+    ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
+     (!PFX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
@@ -32,7 +39,7 @@ typedef struct {
     uint8_t role;     /* PFX__ROLE_... */
     uint8_t size;     /* bytes (0 for the content) */
     uint8_t big;      /* big-endian */
-    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive); extra: which */
     uint8_t last;
     uint8_t check;    /* checksum: which algorithm (pfx__check) */
     uint8_t has_also; /* value: one more value allowed (a broadcast address) */
@@ -80,7 +87,11 @@ typedef struct {
 } pfx__where_t;
 
 #if PFX_ENABLE_DECODE
-static uint32_t pfx__get(const uint8_t *b, uint8_t size, uint8_t big)
+"""
+
+# A frame element's value from its bytes: the engine's for stuffed layouts, and the content code's where it asks
+# (Ctx.helpers "get"); left out of a spec whose C calls it nowhere
+GET = r"""static uint32_t pfx__get(const uint8_t *b, uint8_t size, uint8_t big)
 {
     uint32_t v = 0u;
     uint8_t i;
@@ -90,7 +101,9 @@ static uint32_t pfx__get(const uint8_t *b, uint8_t size, uint8_t big)
     return v;
 }
 
-#endif
+"""
+
+TAIL = r"""#endif
 
 #if PFX_ENABLE_ENCODE
 static void pfx__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
@@ -201,7 +214,7 @@ static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, 
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
 static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
-                     const uint32_t *values, size_t *len)
+                     const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
     pfx__where_t w;
     size_t pos = 0u, i, sz;
@@ -278,6 +291,8 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             pfx__put(out + pos, e->size, e->big, code);
         } else if (e->role == PFX__ROLE_VALUE) {
             pfx__put(out + pos, e->size, e->big, values[v++]);
+        } else if (PFX__OPTIONAL && e->role == PFX__ROLE_EXTRA) {
+            memcpy(out + pos, extras[e->first], e->size);
         } else if (e->role != PFX__ROLE_CONTENT) {
             memset(out + pos, 0, e->size);
         }
@@ -286,6 +301,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     }
     (void)first;
     (void)last;
+    (void)extras;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
@@ -383,7 +399,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
             *code = pfx__get(bytes, e->size, e->big);
         } else if (e->role == PFX__ROLE_VALUE) {
             uint32_t value = pfx__get(bytes, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(PFX__PLAUSIBLE(e, value))) {
                 return PFX_E_RANGE;
             }
             values[v++] = value;
@@ -454,7 +470,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             }
         } else if (e->role == PFX__ROLE_VALUE) {
             uint32_t value = pfx__get(b + pos, e->size, e->big);
-            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+            if (!(PFX__PLAUSIBLE(e, value))) {
                 return PFX__NONE;
             }
         }
@@ -514,3 +530,5 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
 }
 #endif
 """
+
+ENGINE = HEAD + GET + TAIL

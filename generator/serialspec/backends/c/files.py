@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from serialspec import __version__
-from serialspec.backends.c import length_byte, packed
+from serialspec.backends.c import length_byte, optional, packed
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
+    Member,
     comment,
     content_max,
     decoder,
@@ -21,7 +22,7 @@ from serialspec.backends.c.emit import (
     spec_hash,
     value_elements,
 )
-from serialspec.backends.c.engine import ENGINE
+from serialspec.backends.c.engine import GET, HEAD, TAIL
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
@@ -75,6 +76,12 @@ def role_macros(P: str) -> str:
 """
 
 
+def max_frame(protocol: Protocol) -> tuple[int, int]:
+    """The largest frame the spec allows, and P_MAX_FRAME's default."""
+    spec_max = max((frame_max(protocol, d) or 1 << 30) for d in directions(protocol))
+    return spec_max, min(spec_max, DEFAULT_MAX_FRAME)
+
+
 def header(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
     wake = (
@@ -95,23 +102,25 @@ def header(ctx: Ctx) -> str:
             "    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */"
         )
     msgs = messages(protocol)
-    spec_max = max((frame_max(protocol, d) or 1 << 30) for d in directions(protocol))
-    default_frame = min(spec_max, DEFAULT_MAX_FRAME)
+    spec_max, default_frame = max_frame(protocol)
     structs: list[str] = []
     for m in msgs:
         mid = msg_id(m)
         room = content_max(protocol, m.direction)
         if m.max_size is not None:
             room = min(room, m.max_size)
-        mems = [
-            f"    {_ctype_of(t)} {ident(name)};  /* frame {name} */"
+        found = [
+            Member(ident(name), f"{_ctype_of(t)} {ident(name)};", f"frame {name}", _ctype_of(t))
             for name, t in value_elements(protocol, m.direction)
         ]
         element = error_element(protocol, m)
         if element is not None:
-            mems.append(f"    {_ctype_of(element[1])} {ident(element[0])};  /* the code of the request refused */")
-        for member in members(ctx, m.fields, mid, room):
-            mems.append(f"    {member.decl}{'  /* ' + member.doc + ' */' if member.doc else ''}")
+            t = _ctype_of(element[1])
+            found.append(Member(ident(element[0]), f"{t} {ident(element[0])};", "the code of the request refused", t))
+        found += members(ctx, m.fields, mid, room)
+        found += optional.members(ctx, m.direction)
+        ctx.message_members[mid] = found
+        mems = [f"    {member.decl}{'  /* ' + member.doc + ' */' if member.doc else ''}" for member in found]
         title = protocol.command(m.command).title or m.key
         structs.append(
             f"/* {comment(title)} ({m.direction.value}). {comment(m.description)} */\n"
@@ -144,7 +153,7 @@ extern "C" {{
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define {P}_SPEC_SHA256 "{spec_hash(protocol)}"
+#define {P}_SPEC_SHA256 "{spec_hash(ctx.original or protocol)}"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef {P}_ENABLE_ENCODE
@@ -267,6 +276,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     names = [e.name for e in layout.elements]
     lines: list[str] = []
     rows: list[str] = []
+    needs = ctx.variants[direction][k].bit_of if ctx.variants else {}
     for i, e in enumerate(layout.elements):
         constant = "NULL"
         if e.role in ("header", "trailer", "constant"):
@@ -284,6 +294,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             "length": "LENGTH",
             "content": "CONTENT",
             "checksum": "CHECKSUM",
+            optional.EXTRA: "EXTRA",
         }[e.role]
         size = len(e.constant) if constant != "NULL" else (e.size or 0)
         first = last = check = 0
@@ -292,6 +303,10 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         if e.role == "checksum" and e.checksum is not None:
             first, last = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
+        if e.role == optional.EXTRA:  # which of the direction's optional elements (the message's extras[first])
+            first = [x.name for x in optional.elements_of(ctx, direction)].index(e.name)
+        if e.name in needs:  # a value flag element's bit in this variant: (bit number + 1, set)
+            first, last = needs[e.name]
         value = e.role in (*VALUE_ROLES, "command")
         minimum = int(e.minimum) if value else 0
         maximum = int(e.maximum) if value else 0
@@ -346,16 +361,17 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
 def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
     """A frame element's value from its bytes in f (at an offset from the start, or back from the end n), built with
     shifts (any host byte order)."""
-    from_end, offset = where
-
-    def byte(i: int) -> str:
-        return f"f[n - {offset - i}u]" if from_end else f"f[{offset + i}u]"
-
     order = list(range(size)) if big else list(range(size - 1, -1, -1))
     return " | ".join(
-        f"((uint32_t){byte(i)} << {8 * (size - 1 - j)}u)" if j < size - 1 else f"(uint32_t){byte(i)}"
+        f"((uint32_t){_byte(where, i)} << {8 * (size - 1 - j)}u)" if j < size - 1 else f"(uint32_t){_byte(where, i)}"
         for j, i in enumerate(order)
     )
+
+
+def _byte(where: tuple[bool, int], i: int) -> str:
+    """Byte i of a frame element in f (at an offset from the start, or back from the end n)."""
+    from_end, offset = where
+    return f"f[n - {offset - i}u]" if from_end else f"f[{offset + i}u]"
 
 
 def _prefix(ctx: Ctx, layout: FrameLayout) -> int:
@@ -374,18 +390,28 @@ def _prefix(ctx: Ctx, layout: FrameLayout) -> int:
     return prefix
 
 
-def _range_test(e: FrameElement, value: str, size: int) -> str | None:
-    """The C test that a frame value is outside its element's range (None: every value of its size is in it)."""
+def _need(ctx: Ctx, direction: Direction, k: int, e: FrameElement) -> tuple[int, int] | None:
+    """The (mask, bits) a value flag element must have in variant k (optional elements), else None."""
+    return ctx.variants[direction][k].needs.get(e.name) if ctx.variants else None
+
+
+def _range_test(e: FrameElement, value: str, size: int, need: tuple[int, int] | None = None) -> str | None:
+    """The C test that a frame value is outside its element's range (None: every value of its size is in it), or has
+    not the bits `need` (mask, bits) says (a variant's value flag)."""
     test = []
     if int(e.minimum) > 0:
         test.append(f"{value} < {int(e.minimum)}u")
     if int(e.maximum) < (1 << (8 * size)) - 1:
         test.append(f"{value} > {int(e.maximum)}u")
+    if not test and need is not None:
+        return f"({value} & {need[0]}u) != {need[1]}u"
     if not test:
         return None
     cond = " || ".join(test)
     if e.broadcast is not None:
         cond = f"({cond}) && {value} != {e.broadcast}u"
+    if need is not None:
+        cond = f"({cond}) || ({value} & {need[0]}u) != {need[1]}u"
     return cond
 
 
@@ -433,7 +459,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
             )
         elif e.role in VALUE_ROLES:
-            test = _range_test(e, "v", sizes[i])
+            test = _range_test(e, "v", sizes[i], _need(ctx, direction, k, e))
             if test is not None:
                 lines.append(f"    {{ uint32_t v = {value}; if ({test}) {{ return {P}__NONE; }} }} /* {e.name} */")
         offset = stop
@@ -518,8 +544,7 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
     for i, e in enumerate(elements):
         if e.role in ("header", "trailer", "constant"):
             for j, byte in enumerate(e.constant):
-                index = _wire_value(start[i], j + 1, True).rsplit("(uint32_t)", 1)[1]
-                lines.append(f"    if ({index} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */")
+                lines.append(f"    if ({_byte(start[i], j)} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */")
     v = 0
     for i, e in enumerate(elements):
         value = _wire_value(start[i], sizes[i], e.endian == ">")
@@ -538,6 +563,9 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
                 if e.broadcast is not None:
                     cond = f"({cond}) && values[{v}] != {e.broadcast}u"
                 lines.append(f"    if ({cond}) {{ return {P}_E_RANGE; }}")
+            need = _need(ctx, direction, k, e)
+            if need is not None:  # the variant's flag bit (its caller chose it by that bit: a check kept as Python's)
+                lines.append(f"    if ((values[{v}] & {need[0]}u) != {need[1]}u) {{ return {P}_E_RANGE; }}")
             v += 1
     for i, e in enumerate(elements):
         if e.role == "length":
@@ -592,9 +620,12 @@ def source(ctx: Ctx) -> str:
     command_cases: list[str] = []
     count_cases: list[str] = []
     least_cases: list[str] = []
+    waits = False  # the classic parser waits for a prefix in some direction
     for d in directions(protocol):
         alternatives = protocol.framing.alternatives[d]
-        least_cases.append(f"    case {P}_{d.name}:\n        return {min(_prefix(ctx, a) for a in alternatives)}u;")
+        fewest = min(_prefix(ctx, a) for a in alternatives)
+        waits = waits or fewest != 0
+        least_cases.append(f"    case {P}_{d.name}:\n        return {fewest}u;")
         count_cases.append(f"    case {P}_{d.name}:\n        return {len(alternatives)}u;")
         mask = sum(1 << k for k, layout in enumerate(alternatives) if layout.has_command)
         command_cases.append(f"    case {P}_{d.name}:\n        return (({mask}UL >> k) & 1u) != 0u;")
@@ -654,7 +685,11 @@ def source(ctx: Ctx) -> str:
     return r;
 }}
 """
-    engine = ENGINE.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
+    size_rules = "\n".join(size_rule_cases(ctx, d) for d in directions(protocol))
+    any_stuffed = any(stuffed.values())
+    # __get: read by the engine's code for stuffed layouts and by the content code that asks for it
+    engine = HEAD + (GET if any_stuffed or "get" in ctx.helpers else "") + TAIL
+    engine = engine.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
     engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks
     bounds_cases: list[str] = []
@@ -712,10 +747,11 @@ def source(ctx: Ctx) -> str:
                 body.append("            }")
             elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
-                    fits = f"n >= {u.min_size}u" if u.min_size else ""
+                    tests = [f"n >= {u.min_size}u"] if u.min_size else []
                     if u.max_size is not None and u.max_size <= 0xFFFFFFFF:
-                        fits = f"n == {u.min_size}u" if u.max_size == u.min_size else f"{fits} && n <= {u.max_size}u"
-                    fits = (fits or "1").removeprefix(" && ")
+                        same = u.max_size == u.min_size
+                        tests = [f"n == {u.min_size}u"] if same else [*tests, f"n <= {u.max_size}u"]
+                    fits = " && ".join(tests) or "1"
                     body.append(f"            if ({fits}) {{ {dec_call(ctx, u, values)} }}")
                 body.append(f"            return {P}_E_LENGTH;")
             else:
@@ -736,13 +772,15 @@ def source(ctx: Ctx) -> str:
         )
     # encoders: public per-message functions
     pub_encoders: list[str] = []
+    opt = optional.has_optional(ctx)
+    xargs = "present, extras, " if opt else ""
     for m in msgs:
         mid = msg_id(m)
         layout = protocol.framing.layouts[m.direction]
         values = value_elements(protocol, m.direction)
         number = protocol.command(m.command).wire_code(m.direction) if layout.has_command else None
         wire_code = f"{number if number is not None else 0}UL"
-        vchecks = []
+        xdecls, vchecks = optional.encode_lines(ctx, m.direction) if opt else ([], [])
         vsets = []
         element = error_element(protocol, m)
         if element is not None and protocol.error_reply is not None:
@@ -769,13 +807,14 @@ def source(ctx: Ctx) -> str:
                     f"int {p}_encode_{mid}(const {p}_{mid}_t *m, uint8_t *buf, size_t cap, size_t *len)",
                     "{",
                     f"    uint32_t values[{max(1, len(values))}];",
+                    *xdecls,
                     f"    if (m == NULL || buf == NULL || len == NULL) {{ return {P}_E_ARG; }}",
                     "    *len = 0u;",
                     f"    if (!{P}_ENCODES_{m.direction.name}S) {{ return {P}_E_ARG; }} /* left out of this build */",
                     *vchecks,
                     *vsets,
                     *([] if values else ["    values[0] = 0u;"]),
-                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, m, "
+                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}m, "
                     f"{p}__enc_{mid}, buf, cap, len);",
                     "}",
                     "",
@@ -802,9 +841,8 @@ def source(ctx: Ctx) -> str:
         f"    case {P}_{d.name}:\n        *count = {n_layouts[d]}u;\n        return {p}__layouts_{d.value};"
         for d in directions(protocol)
     )
-    any_stuffed = any(stuffed.values())
     least, least_check = "", ""
-    if any(c.split("return ")[1] != "0u;" for c in least_cases):  # the classic parser waits for a prefix
+    if waits:
         least = f"""
 /* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
 static size_t {p}__least({p}_direction_t dir)
@@ -829,6 +867,20 @@ static size_t {p}__least({p}_direction_t dir)
     # a framing without checksums still has the (empty) dispatch, which never reads its bytes
     no_checksums = "" if cases.strip() else "\n    (void)d;\n    (void)n;"
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
+    optionals = max((len(optional.elements_of(ctx, d)) for d in directions(protocol)), default=0)
+    xparams = "uint8_t present, const uint8_t *const *extras, " if opt else ""
+    xdecl = "const uint8_t *const *extras, " if opt else ""
+    xarg = "extras, " if opt else ""
+    skip_variant = (
+        f"\n        if ({p}__present(dir, k) != present) {{ /* a variant sending other optional elements */"
+        "\n            continue;\n        }"
+        if opt
+        else ""
+    )
+    admits = f"{p}__admits(dir, k, frame, len)" if opt else "1"
+    admits_fn = optional.admits(ctx) if opt else ""
+    extras_decl = f"\n    const uint8_t *extras[{optionals}];" if opt else ""
+    find_extras = "\n    " + f"{p}__extras(dir, k, frame, len, extras);" if opt else ""
     all_lengths = int(all(layout.length is not None for layout in every))
     single = int(all(n == 1 for n in n_layouts.values()))
     text = f"""{banner(protocol)}
@@ -864,6 +916,8 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #else
 #define {P}__RX(dir) (dir)
 #endif
+#define {P}__OPTIONAL {int(opt)} /* some layout has optional elements (`present_if`): its variants are layouts */
+#define {P}__OPTIONALS {optionals}u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
 {check_defs}
@@ -906,7 +960,7 @@ static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, 
     (void)avail;
     (void)size;
     switch (dir) {{
-{chr(10).join(size_rule_cases(ctx, d) for d in directions(protocol))}
+{size_rules}
     default:
         return {P}__NONE;
     }}
@@ -924,8 +978,11 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     }}
 }}
 
-/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
-{chr(10).join(probes)}
+"""
+    probing = (
+        "/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */\n"
+    )
+    probing += f"""{chr(10).join(probes)}
 /* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when
  * none starts there. */
 static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
@@ -948,7 +1005,8 @@ static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size
     return {P}__NONE;
 #endif
 }}
-#endif
+"""
+    middle = f"""#endif
 
 #if {P}_ENABLE_DECODE
 /* ---- what the decoder and the parser ask of a layout, without the tables ---- */
@@ -1012,10 +1070,11 @@ static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, 
 #endif
 }}
 
+{admits_fn}
 /* ---- content decoders ---- */
 {decoders}
 static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect, const uint8_t *c, size_t n,
-                                const uint32_t *values, {p}_msg_t *out)
+                                const uint32_t *values, {xdecl}{p}_msg_t *out)
 {{
     int r;
     (void)expect;
@@ -1029,7 +1088,7 @@ static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect
 
 int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
 {{
-    uint8_t count, k;
+    uint8_t count, k;{extras_decl}
     uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -1048,22 +1107,27 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     }}
     k = 0u;
     if (!{P}__SINGLE && count != 1u) {{
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
         for (k = 0u; k < count; k++) {{
             size_t hl;
             const uint8_t *h = {p}__header(dir, k, &hl);
             if (hl <= len && {p}__same(frame, h, hl)) {{
-                break;
+                headed = 1;
+                if ({admits}) {{
+                    break;
+                }}
             }}
         }}
         if (k == count) {{
-            return {P}_E_FRAME;
+            return headed ? {P}_E_LENGTH : {P}_E_FRAME;
         }}
     }}
     r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
-    }}
-    r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values, out);
+    }}{find_extras}
+    r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values,
+                            {xarg}out);
     if (r != {P}_OK) {{
         out->kind = {P}_KIND_NONE;
     }}
@@ -1080,11 +1144,11 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 /* ---- content encoders ---- */
 typedef int (*{p}__enc_t)(const void *m, uint8_t *c, size_t cap, size_t *n);
 
-{encoders}
+{encoders}{optional.present(ctx) if opt else ""}
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
-static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values, const void *m, {p}__enc_t enc,
-                      uint8_t *buf, size_t cap, size_t *len)
+static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values, {xparams}const void *m,
+                      {p}__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
 {{
     uint8_t count, k, i;
     const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
@@ -1095,7 +1159,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = {P}__T(L) ? L->t_first : 0u;
+        uint8_t from = {P}__T(L) ? L->t_first : 0u;{skip_variant}
         for (i = from; (int)i < L->content; i++) {{
             before += L->e[i].size;
         }}
@@ -1114,7 +1178,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         }}
         r = enc(m, dst, room, &clen);
         if (r == {P}_OK) {{
-            r = {p}__wrap(L, buf, cap, span, clen, code, values, len);
+            r = {p}__wrap(L, buf, cap, span, clen, code, values, {"extras" if opt else "NULL"}, len);
         }}
         if (r == {P}_OK) {{
             return r;
@@ -1142,7 +1206,8 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 }}
 #endif
 
-#if {P}_ENABLE_PARSER
+"""
+    parsing = f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
 
 #define {P}__ACCEPT 0
@@ -1160,13 +1225,13 @@ void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
  * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 {{
-    uint8_t count = {p}__count(p->dir), k;
+    uint8_t count = {p}__count({P}__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
     }}
     for (k = 0u; k < count; k++) {{
-        long s = {p}__probe_at(p->dir, k, p->buf + pos, p->n - pos);
+        long s = {p}__probe_at({P}__RX(p->dir), k, p->buf + pos, p->n - pos);
         if (s == {P}__WAIT) {{
             need = 0u;
             continue;
@@ -1180,7 +1245,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
             }}
             continue;
         }}
-        if ({p}_decode(p->buf + pos, (size_t)s, p->dir, out) != {P}_OK) {{
+        if ({p}_decode(p->buf + pos, (size_t)s, {P}__RX(p->dir), out) != {P}_OK) {{
             if (need == (size_t)-1) {{
                 p->verdict[pos] = {P}__V_CORRUPT;
             }}
@@ -1201,7 +1266,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 static size_t {p}__next({p}_parser_t *p, size_t start)
 {{
 #if {P}__HEADERS
-    uint8_t count = {p}__count(p->dir), k;
+    uint8_t count = {p}__count({P}__RX(p->dir)), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {{
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -1210,7 +1275,7 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
         }}
         for (k = 0u; k < count; k++) {{
             size_t hl;
-            const uint8_t *h = {p}__header(p->dir, k, &hl);
+            const uint8_t *h = {p}__header({P}__RX(p->dir), k, &hl);
             if (hl > p->n - pos) {{
                 whole = 0;
             }} else if ({p}__same(p->buf + pos, h, hl)) {{
@@ -1248,10 +1313,10 @@ static void {p}__drop({p}_parser_t *p, size_t cut)
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int {p}__ends_header(const {p}_parser_t *p)
 {{
-    uint8_t count = {p}__count(p->dir), k;
+    uint8_t count = {p}__count({P}__RX(p->dir)), k;
     for (k = 0u; k < count; k++) {{
         size_t hl;
-        const uint8_t *h = {p}__header(p->dir, k, &hl);
+        const uint8_t *h = {p}__header({P}__RX(p->dir), k, &hl);
         if (hl <= p->n && {p}__same(p->buf + p->n - hl, h, hl)) {{
             return 1;
         }}
@@ -1342,14 +1407,14 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     size_t i, size, hl;
     const uint8_t *h;
     long s;
-    if (!{P}__SINGLE && {p}__count(p->dir) != 1u) {{
+    if (!{P}__SINGLE && {p}__count({P}__RX(p->dir)) != 1u) {{
         return 0u;
     }}
-    h = {p}__header(p->dir, 0u, &hl);
+    h = {p}__header({P}__RX(p->dir), 0u, &hl);
     if (h == NULL || len < hl || !{p}__same(data, h, hl)) {{
         return 0u;
     }}
-    s = {p}__probe_at(p->dir, 0u, data, len);
+    s = {p}__probe_at({P}__RX(p->dir), 0u, data, len);
     if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME || (size_t)s > len) {{
         return 0u;
     }}
@@ -1359,7 +1424,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
             return 0u;
         }}
     }}
-    if ({p}_decode(data, size, p->dir, out) != {P}_OK) {{
+    if ({p}_decode(data, size, {P}__RX(p->dir), out) != {P}_OK) {{
         return 0u;
     }}
     p->frames++;
@@ -1371,6 +1436,11 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
 {{
     size_t i;
     *got = false;
+#if {P}_ROLE != {P}_ROLE_BOTH
+    if (!{P}__DECODES(parser->dir)) {{ /* the other side's direction, left out of this build */
+        return len;
+    }}
+#endif
     for (i = 0u; i < len; i++) {{
 #if {P}__HEADERS && {P}_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {{
@@ -1389,7 +1459,8 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
     return len;
 }}
 #endif
-
+"""
+    tail = f"""
 const char *{p}_kind_name({p}_kind_t kind)
 {{
     switch (kind) {{
@@ -1411,25 +1482,11 @@ const char *{p}_result_name(int result)
     return names[result];
 }}
 """
-    # frames of the length-byte shape: a straight-line parser that keeps per byte held what the scan needs again
-    text = length_byte.replace_parser(ctx, text) if length_byte.applies(protocol) else text
-    return one_side_parser(ctx, text)
-
-
-def one_side_parser(ctx: Ctx, text: str) -> str:
-    """The parser (either one) reads its direction through P__RX, a constant in a build for one role, so the other
-    side's sizes and decoders are left out; its feed finds nothing in the other side's direction."""
-    p, P = ctx.p, ctx.P
-    start = text.index(f"#if {P}_ENABLE_PARSER\n/* ---- the stream parser")
-    feed = text.index(f"size_t {p}_parser_feed(", start)
-    got = text.index("    *got = false;\n", feed) + len("    *got = false;\n")
-    guard = (
-        f"#if {P}_ROLE != {P}_ROLE_BOTH\n"
-        f"    if (!{P}__DECODES(parser->dir)) {{ /* the other side's direction, left out of this build */\n"
-        "        return len;\n    }\n#endif\n"
-    )
-    parser = text[start:got].replace("p->dir", f"{P}__RX(p->dir)")
-    return text[:start] + parser + guard + text[got:]
+    if length_byte.applies(protocol):
+        # frames of the length-byte shape: a straight-line parser that keeps per byte held what the scan needs again
+        # in place of the general one, and of the probes only that one calls
+        probing, parsing = "", length_byte.parser(ctx)
+    return text + probing + middle + parsing + tail
 
 
 ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY
@@ -1465,6 +1522,7 @@ def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
             big = 1 if endian == "big" else 0
             body.append(f"            if (avail < {offset + size}u) {{ return {ctx.P}__WAIT; }}")
             body.append(f"            size += {factor}L * (long){ctx.p}__get(c + {offset}, {size}u, {big}u);")
+            ctx.helpers.add("get")
         body.append("            return size;")
         rows.append("\n".join(body))
     return (
@@ -1483,6 +1541,7 @@ def span_decl_all(decls: dict[Direction, str], P: str) -> str:
 def dec_call(ctx: Ctx, m: Message, values: tuple[tuple[str, object], ...]) -> str:
     mid = msg_id(m)
     sets = " ".join(f"out->u.{mid}.{ident(name)} = ({_ctype_of(t)})values[{i}];" for i, (name, t) in enumerate(values))
+    sets = f"{sets} {optional.dec_sets(ctx, mid, m.direction)}".strip()
     return f"out->kind = {kind_name(ctx, m)}; r = {ctx.p}__dec_{mid}(c, n, &out->u.{mid}); {sets} return r;"
 
 
@@ -1734,7 +1793,9 @@ def json_source(ctx: Ctx) -> str:
             f"        {p}__json_{msg_id(m)}(&w, &msg->u.{msg_id(m)});\n"
             "        break;"
         )
-    integers = "".join(json_integers(p, suffix, bits) for suffix, bits in (("", 32), ("64", 64)))
+    # the writers the JSON functions call (Ctx.json_writers), callers before the helpers they call
+    used = ctx.json_writers | {{"wi": "wu", "wi64": "wu64"}.get(name, name) for name in ctx.json_writers}
+    writers = "".join(text for name, text in json_writers(p) if name in used)
     text = f"""{banner(protocol)}
 #include "{p}_json.h"
 
@@ -1762,7 +1823,40 @@ static void {p}__ws({p}__w_t *w, const char *s)
     }}
 }}
 
-{integers}static void {p}__wf({p}__w_t *w, double v)
+{writers}{functions}
+size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
+{{
+    {p}__w_t w;
+    w.out = out;
+    w.cap = cap;
+    w.n = 0u;
+    if (msg == NULL) {{
+        {p}__ws(&w, "null");
+    }} else {{
+        switch (msg->kind) {{
+{chr(10).join(cases)}
+        case {P}_KIND_NONE:
+        case {P}_KIND_COUNT:
+        default:
+            {p}__ws(&w, "{{\\"fields\\": {{");
+            break;
+        }}
+        {p}__ws(&w, "}}}}");
+    }}
+    if (cap > 0u) {{
+        out[w.n < cap ? w.n : cap - 1u] = '\\0';
+    }}
+    return w.n;
+}}
+"""
+    return text
+
+
+def json_writers(p: str) -> list[tuple[str, str]]:
+    """The JSON writer's value functions by name (p__wu, p__wi, p__wu64, p__wi64, p__wf, p__wbytes, p__wtext), in
+    the order they are defined."""
+    integers = [pair for suffix, bits in (("", 32), ("64", 64)) for pair in json_integers(p, suffix, bits)]
+    wf = f"""static void {p}__wf({p}__w_t *w, double v)
 {{
     char t[40];
     if (v != v) {{
@@ -1780,7 +1874,8 @@ static void {p}__ws({p}__w_t *w, const char *s)
     }}
 }}
 
-static void {p}__wbytes({p}__w_t *w, const uint8_t *b, size_t n)
+"""
+    wbytes = f"""static void {p}__wbytes({p}__w_t *w, const uint8_t *b, size_t n)
 {{
     static const char hex[] = "0123456789abcdef";
     size_t i;
@@ -1795,7 +1890,8 @@ static void {p}__wbytes({p}__w_t *w, const uint8_t *b, size_t n)
     {p}__wc(w, '"');
 }}
 
-static void {p}__wtext({p}__w_t *w, const char *s, size_t n)
+"""
+    wtext = f"""static void {p}__wtext({p}__w_t *w, const char *s, size_t n)
 {{
     static const char hex[] = "0123456789abcdef";
     size_t i;
@@ -1826,38 +1922,13 @@ static void {p}__wtext({p}__w_t *w, const char *s, size_t n)
     {p}__wc(w, '"');
 }}
 
-{functions}
-size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
-{{
-    {p}__w_t w;
-    w.out = out;
-    w.cap = cap;
-    w.n = 0u;
-    if (msg == NULL) {{
-        {p}__ws(&w, "null");
-    }} else {{
-        switch (msg->kind) {{
-{chr(10).join(cases)}
-        case {P}_KIND_NONE:
-        case {P}_KIND_COUNT:
-        default:
-            {p}__ws(&w, "{{\\"fields\\": {{");
-            break;
-        }}
-        {p}__ws(&w, "}}}}");
-    }}
-    if (cap > 0u) {{
-        out[w.n < cap ? w.n : cap - 1u] = '\\0';
-    }}
-    return w.n;
-}}
 """
-    return drop_unused(text, p, ("wi64", "wu64", "wi", "wu", "wf", "wbytes", "wtext"), functions)
+    return [*integers, ("wf", wf), ("wbytes", wbytes), ("wtext", wtext)]
 
 
-def json_integers(p: str, suffix: str, bits: int) -> str:
+def json_integers(p: str, suffix: str, bits: int) -> list[tuple[str, str]]:
     """The JSON writer's unsigned and signed decimal integers of `bits` bits (p__wu, p__wi; p__wu64, p__wi64)."""
-    return f"""static void {p}__wu{suffix}({p}__w_t *w, uint{bits}_t v)
+    unsigned = f"""static void {p}__wu{suffix}({p}__w_t *w, uint{bits}_t v)
 {{
     char t[{12 if bits == 32 else 21}];
     int i = 0;
@@ -1870,7 +1941,8 @@ def json_integers(p: str, suffix: str, bits: int) -> str:
     }}
 }}
 
-static void {p}__wi{suffix}({p}__w_t *w, int{bits}_t v)
+"""
+    signed = f"""static void {p}__wi{suffix}({p}__w_t *w, int{bits}_t v)
 {{
     if (v < 0) {{
         {p}__wc(w, '-');
@@ -1881,15 +1953,4 @@ static void {p}__wi{suffix}({p}__w_t *w, int{bits}_t v)
 }}
 
 """
-
-
-def drop_unused(text: str, p: str, names: tuple[str, ...], users: str) -> str:
-    """The static helpers no generated function calls left out (-Wunused-function)."""
-    for name in names:  # callers before the helpers they call
-        start = text.index(f"static void {p}__{name}(")
-        stop = text.index("\n}\n", start) + 3
-        if f"{p}__{name}(" in users:
-            users += text[start:stop]
-            continue
-        text = text[:start] + text[stop:].lstrip("\n")
-    return text
+    return [(f"wu{suffix}", unsigned), (f"wi{suffix}", signed)]

@@ -69,7 +69,7 @@ def _by_direction(protocol: Protocol, P: str, values: dict[Direction, str]) -> s
         return values[known[0]]
     text = values[known[-1]]
     for d in reversed(known[:-1]):
-        text = f"(p->dir == {P}_{d.name} ? {values[d]} : {text})"
+        text = f"({P}__RX(p->dir) == {P}_{d.name} ? {values[d]} : {text})"
     return text
 
 
@@ -198,9 +198,9 @@ static int {p}__scan({p}_parser_t *p, {p}_msg_t *out)
             continue;
         }}
         if (v[pos] == {P}__C_SIZED) {{
-            size = {p}__size(p->dir, p->buf + pos);
+            size = {p}__size({P}__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {{
-                if ({p}_decode(p->buf + pos, size, p->dir, out) == {P}_OK) {{
+                if ({p}_decode(p->buf + pos, size, {P}__RX(p->dir), out) == {P}_OK) {{
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -287,7 +287,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     }}
     if (n >= need && v[end - need] == {P}__C_NEW) {{
         at = end - need;
-        size = {p}__size(p->dir, b + at);
+        size = {p}__size({P}__RX(p->dir), b + at);
         if (size == 0u) {{
             v[at] = 0u;
         }} else {{
@@ -323,7 +323,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     if (len < {need} || !{p}__same(data, h, hl)) {{
         return 0u;
     }}
-    size = {p}__size(p->dir, data);
+    size = {p}__size({P}__RX(p->dir), data);
     if (size == 0u || size > len) {{
         return 0u;
     }}
@@ -332,7 +332,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
             return 0u;
         }}
     }}
-    if ({p}_decode(data, size, p->dir, out) != {P}_OK) {{
+    if ({p}_decode(data, size, {P}__RX(p->dir), out) != {P}_OK) {{
         return 0u;
     }}
     p->frames++;
@@ -344,6 +344,11 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
 {{
     size_t i;
     *got = false;
+#if {P}_ROLE != {P}_ROLE_BOTH
+    if (!{P}__DECODES(parser->dir)) {{ /* the other side's direction, left out of this build */
+        return len;
+    }}
+#endif
     for (i = 0u; i < len; i++) {{
 #if {P}_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {{
@@ -363,14 +368,3 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
 }}
 #endif
 """
-
-
-def replace_parser(ctx: Ctx, text: str) -> str:
-    """The general parser and the probes only it calls, in the source files.py writes, replaced by the one above."""
-    p = ctx.p
-    start = text.index("/* ---- candidates sized:")
-    stop = text.index("\n}\n", text.index(f"static long {p}__probe_at(")) + 3
-    text = text[:start] + text[stop:]
-    start = text.index(f"#if {ctx.P}_ENABLE_PARSER\n/* ---- the stream parser")
-    stop = text.index("\n}\n#endif\n", text.index(f"size_t {p}_parser_feed(")) + len("\n}\n#endif\n")
-    return text[:start] + parser(ctx) + text[stop:]

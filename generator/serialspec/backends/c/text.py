@@ -12,7 +12,7 @@ from typing import assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.c.emit import comment, ident, spec_hash
 from serialspec.backends.c.files import role_macros
-from serialspec.backends.c.text_runtime import TEXT_RUNTIME
+from serialspec.backends.c.text_runtime import BEFORE_PARSER, CHECKED_READ, CHECKED_WRITE, HEAD, MIDDLE, PARSER
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
@@ -443,10 +443,9 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
     return r;
 }}
 """
-        runtime = TEXT_RUNTIME.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
-        if not checked:  # the checksum's code left out
-            runtime = re.sub(rf"#if {P}__CHECKED\n.*?#endif\n", "", runtime, flags=re.DOTALL)
-        runtime, parser = runtime.split("/* ---- the parser ---- */\n")
+        parts = (HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER) if checked else (HEAD, MIDDLE, BEFORE_PARSER)
+        runtime = "".join(parts).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")  # the checksum's code: if any
+        parser = PARSER.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}

@@ -2,7 +2,7 @@
 cursor and the line parser, following serialspec.runtime.text (decode_field, encode_field, TextStreamParser).
 PFX_/pfx_ stand for the protocol's prefix; text.py writes what is the spec's (messages, codes, letters, ranges)."""
 
-TEXT_RUNTIME = r"""/* ---- the text runtime (runtime/text.py, as C) ---- */
+HEAD = r"""/* ---- the text runtime (runtime/text.py, as C) ---- */
 
 static int64_t pfx__pow10(unsigned k)
 {
@@ -432,7 +432,10 @@ static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
         return PFX_E_FRAME;
     }
     stop = end;
-#if PFX__CHECKED
+"""
+
+# the checksum read and written where the protocol has one (text.py leaves them out otherwise)
+CHECKED_READ = r"""#if PFX__CHECKED
     {
         size_t at = end, k;
         uint32_t written = 0u;
@@ -459,7 +462,9 @@ static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
         }
     }
 #endif
-    *body = 1u;
+"""
+
+MIDDLE = r"""    *body = 1u;
     *n = stop - 1u;
     return PFX_OK;
 }
@@ -496,7 +501,9 @@ static int pfx__frame(pfx__out_t *o, size_t *len)
 {
     size_t k;
     o->b[0] = PFX__START;
-#if PFX__CHECKED
+"""
+
+CHECKED_WRITE = r"""#if PFX__CHECKED
     {
         uint32_t sum = pfx__checksum(o->b + 1u, o->n - 1u);
         pfx__put(o, PFX__MARKER);
@@ -506,7 +513,9 @@ static int pfx__frame(pfx__out_t *o, size_t *len)
         }
     }
 #endif
-    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
+"""
+
+BEFORE_PARSER = r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
         pfx__put(o, pfx__end[k]);
     }
     if (o->full) {
@@ -517,8 +526,10 @@ static int pfx__frame(pfx__out_t *o, size_t *len)
 }
 #endif
 
-/* ---- the parser ---- */
-#if PFX_ENABLE_PARSER
+"""
+
+# the line parser (text.py writes it after the messages' code)
+PARSER = r"""#if PFX_ENABLE_PARSER
 /* Where `c` is in b[from..n), n if nowhere. */
 static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
 {

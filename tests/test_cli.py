@@ -282,6 +282,7 @@ def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path
     result = serialspec("generate", "specs/feetech_sms.yaml", "--target", "c", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
     assert sorted(p.name for p in (tmp_path / "feetech_sms").iterdir()) == [
+        "README.md",
         "feetech_sms.c",
         "feetech_sms.h",
         "feetech_sms_json.c",

@@ -1238,7 +1238,7 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         assert emitter.verify is None or emitter.verify(protocol, emitter.files(protocol)) == []
         files.update(emitted)
     docs = files["docs/matrix_text.md"]
-    assert "### EV: Every kind" in docs and "`tail[].z`" in docs and "Traceback" not in docs
+    assert "### `EV`: Every kind" in docs and "`tail[].z`" in docs and "Traceback" not in docs
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         for cls in package.MESSAGE_TYPES:

@@ -184,7 +184,7 @@ def test_a_project_table_in_pyproject_sets_specs_and_output(user: User) -> None:
         project / "src" / "docs" / "tinylamp.md"
     ).is_file()
     assert (project / "src" / "c" / "tinylamp" / "tinylamp.h").is_file()  # the C target, beside the package
-    assert robot.serialspec("check").stdout.startswith("18 generated files match")
+    assert robot.serialspec("check").stdout.startswith("19 generated files match")
     (project / "src" / "tinylamp" / "codec.py").write_text("edited\n", encoding="utf-8")
     stale = robot.serialspec("check", check=False)
     assert stale.returncode == 1 and "src/tinylamp/codec.py: stale" in stale.stderr

@@ -739,11 +739,8 @@ class TextCodec:
     def replies(self, code: str) -> tuple[tuple[type, ...], tuple[type, ...]]:
         """The response classes that answer a request of this code, and those that refuse it."""
         answering, refusing = self.answers.get(code, ((code,), ()))
-        found = [
-            tuple(self.classes[c, "response"] for c in codes if (c, "response") in self.classes)
-            for codes in (answering, refusing)
-        ]
-        return found[0], found[1]
+        responses = {c: cls for (c, direction), cls in self.classes.items() if direction == "response"}
+        return tuple(responses[c] for c in answering if c in responses), tuple(responses[c] for c in refusing)
 
     def message(self, sentence: Sentence) -> Any:
         cls = self.classes[sentence.code, sentence.direction]

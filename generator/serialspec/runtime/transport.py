@@ -126,9 +126,7 @@ def check_status(request: Message, reply: Message, name: str, ok: int, match_by:
     value = getattr(reply, name)
     if value != ok:
         shown = f"{value.name.lower()} ({int(value)})" if isinstance(value, IntEnum) else str(value)
-        command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
-        ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
-        raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)
+        raise DeviceError(f"{_asked(request, reply, match_by)}: the device reports {name} = {shown}", reply)
 
 
 def check_echoes(request: Message, reply: Message, names: tuple[str, ...], match_by: tuple[str, ...]) -> None:
@@ -136,10 +134,15 @@ def check_echoes(request: Message, reply: Message, names: tuple[str, ...], match
     for name in names:
         sent, got = getattr(request, name), getattr(reply, name)
         if got != sent:
-            command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
-            ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
-            to = f" to {ids}" if ids else ""
-            raise EchoMismatch(f"{command}{to}: the reply's {name} is {shown(got)}, not the {shown(sent)} sent", reply)
+            asked = _asked(request, reply, match_by)
+            raise EchoMismatch(f"{asked}: the reply's {name} is {shown(got)}, not the {shown(sent)} sent", reply)
+
+
+def _asked(request: Message, reply: Message, match_by: tuple[str, ...]) -> str:
+    """The command and the device a reply answers, for an error line: `read to id=1`."""
+    command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+    ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
+    return f"{command} to {ids}" if ids else command
 
 
 def table_key(table: dict[str, int], name: str) -> int:

@@ -93,6 +93,10 @@ STRESS_FRAMES ?= 100000
 STRESS_TRANSACTIONS ?= 5000
 FUZZ_EXAMPLES ?= 2000
 FUZZ_ARGS ?=
+# property tests that compile C, feed every split or run every output: a short form in `make test`, this many here
+SLOW_FUZZ_EXAMPLES ?= 150
+SLOW_FUZZ_TESTS := tests/test_stream_splits.py tests/test_language_matrix.py tests/test_c_backend.py \
+	tests/test_c_text.py tests/test_stream_lean.py
 FUZZ_TESTS := tests/test_cli_fuzz.py tests/test_spec_fuzz.py tests/test_codec.py tests/test_fast_codec.py \
 	tests/test_framing_engine.py tests/test_batch_stream_fuzz.py tests/test_straight_frames.py
 
@@ -102,6 +106,9 @@ stress: $(STAMP)
 		$(BIN)/pytest -q -s tests/test_stress.py tests/test_faults.py
 	@echo "stress: $(FUZZ_EXAMPLES) examples per fuzzer, random seeds"
 	SERIALSPEC_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -q -p no:cacheprovider $(FUZZ_TESTS) $(FUZZ_ARGS)
+	@echo "stress: $(SLOW_FUZZ_EXAMPLES) examples per slow property test (compiled C, every split, every output)"
+	SERIALSPEC_C_CHECK=1 SERIALSPEC_FUZZ_EXAMPLES=$(SLOW_FUZZ_EXAMPLES) $(BIN)/pytest -q -n auto -p no:cacheprovider \
+		$(SLOW_FUZZ_TESTS) $(FUZZ_ARGS)
 
 # Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about a minute on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.

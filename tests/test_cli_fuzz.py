@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from serialspec.cli import main
 
 SETTINGS = settings(
-    max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(75), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
 
 

@@ -165,7 +165,7 @@ def splits(draw: st.DrawFn, data: bytes) -> list[bytes]:
 
 @pytest.mark.parametrize(("g", "direction"), PARSERS, ids=IDS)
 def test_every_split_gives_the_frames_that_complete_first(g: Generated, direction: Direction | None) -> None:
-    @settings(max_examples=examples(60), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(30), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.data())
     def run(drawn: st.DataObject) -> None:
         waiting = drawn.draw(awaited(g, direction))
@@ -185,7 +185,7 @@ def test_a_frame_comes_out_with_the_read_that_completes_it(g: Generated, directi
     frames one read of the stream so far gives. A frame is delivered by the read that brings its last byte, never
     later (a frame that completes first is final), and the types of the reads change nothing."""
 
-    @settings(max_examples=examples(30), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(15), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.data())
     def run(drawn: st.DataObject) -> None:
         waiting = drawn.draw(awaited(g, direction))

@@ -11,7 +11,7 @@ distinguish from a real one, so the stream builder leaves it out. It finds them 
 the parser under test) and the test bounds how many it left out, so this can neither hide a resynchronisation bug
 nor quietly test less.
 
-`SERIALSPEC_STRESS_FRAMES` sets the intact frames per stream: 5,000 by default (`make test`), 100,000 under
+`SERIALSPEC_STRESS_FRAMES` sets the intact frames per stream: 2,000 by default (`make test`), 100,000 under
 `make stress`, which runs pytest with `-s` so the summary line of each stream is printed.
 """
 
@@ -31,7 +31,7 @@ from serialspec.lang.model import Direction, FrameLayout, Message
 from serialspec.runtime.errors import DecodeError
 from strategies import message_fields
 
-FRAMES = int(os.environ.get("SERIALSPEC_STRESS_FRAMES", "5000"))
+FRAMES = int(os.environ.get("SERIALSPEC_STRESS_FRAMES", "2000"))
 # random valid messages per protocol and direction, the stream samples from them: drawing is the slow part
 POOL_SIZE = min(1000, max(200, FRAMES // 100))
 MAX_FRAME = 255 + 16  # more than any frame a one-byte length can describe, plus the largest overhead

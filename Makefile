@@ -63,10 +63,10 @@ typecheck: $(STAMP)
 # The whole suite on every core (pytest-xdist); `make test-fast` leaves out the tests marked slow (wheels, docs site,
 # vendors' SDKs over pseudo-terminals) for the inner loop of an edit.
 test: $(STAMP) test-tools check lint typecheck
-	$(BIN)/pytest -q -n auto
+	$(BIN)/pytest -q -n auto --dist worksteal
 
 test-fast: $(STAMP) test-tools check
-	$(BIN)/pytest -q -n auto -m "not slow"
+	$(BIN)/pytest -q -n auto --dist worksteal -m "not slow"
 
 # The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc, clang, gcc -m32 and a PowerPC gcc,
 # -std=c99 and the strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with

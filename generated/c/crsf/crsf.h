@@ -323,8 +323,8 @@ void crsf_parser_gap(crsf_parser_t *parser);
  * (and while that data is). */
 const uint8_t *crsf_parser_frame(const crsf_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as crsf_decode_expect(..., reply, ...) decodes them where replies share a code; CRSF_KIND_NONE: the
- * spec's default. */
+ * decoded as crsf_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * CRSF_KIND_NONE: the spec's default. */
 void crsf_parser_expect(crsf_parser_t *parser, crsf_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

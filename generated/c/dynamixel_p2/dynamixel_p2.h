@@ -382,8 +382,8 @@ void dynamixel_p2_parser_gap(dynamixel_p2_parser_t *parser);
  * (and while that data is). */
 const uint8_t *dynamixel_p2_parser_frame(const dynamixel_p2_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as dynamixel_p2_decode_expect(..., reply, ...) decodes them where replies share a code; DYNAMIXEL_P2_KIND_NONE: the
- * spec's default. */
+ * decoded as dynamixel_p2_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * DYNAMIXEL_P2_KIND_NONE: the spec's default. */
 void dynamixel_p2_parser_expect(dynamixel_p2_parser_t *parser, dynamixel_p2_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

@@ -439,8 +439,8 @@ void mavlink_common_parser_gap(mavlink_common_parser_t *parser);
  * (and while that data is). */
 const uint8_t *mavlink_common_parser_frame(const mavlink_common_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as mavlink_common_decode_expect(..., reply, ...) decodes them where replies share a code; MAVLINK_COMMON_KIND_NONE: the
- * spec's default. */
+ * decoded as mavlink_common_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * MAVLINK_COMMON_KIND_NONE: the spec's default. */
 void mavlink_common_parser_expect(mavlink_common_parser_t *parser, mavlink_common_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

@@ -384,8 +384,8 @@ void modbus_ascii_parser_gap(modbus_ascii_parser_t *parser);
  * (and while that data is). */
 const uint8_t *modbus_ascii_parser_frame(const modbus_ascii_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as modbus_ascii_decode_expect(..., reply, ...) decodes them where replies share a code; MODBUS_ASCII_KIND_NONE: the
- * spec's default. */
+ * decoded as modbus_ascii_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * MODBUS_ASCII_KIND_NONE: the spec's default. */
 void modbus_ascii_parser_expect(modbus_ascii_parser_t *parser, modbus_ascii_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

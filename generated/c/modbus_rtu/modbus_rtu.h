@@ -384,8 +384,8 @@ void modbus_rtu_parser_gap(modbus_rtu_parser_t *parser);
  * (and while that data is). */
 const uint8_t *modbus_rtu_parser_frame(const modbus_rtu_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as modbus_rtu_decode_expect(..., reply, ...) decodes them where replies share a code; MODBUS_RTU_KIND_NONE: the
- * spec's default. */
+ * decoded as modbus_rtu_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * MODBUS_RTU_KIND_NONE: the spec's default. */
 void modbus_rtu_parser_expect(modbus_rtu_parser_t *parser, modbus_rtu_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

@@ -347,8 +347,8 @@ void ubx_parser_gap(ubx_parser_t *parser);
  * (and while that data is). */
 const uint8_t *ubx_parser_frame(const ubx_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as ubx_decode_expect(..., reply, ...) decodes them where replies share a code; UBX_KIND_NONE: the
- * spec's default. */
+ * decoded as ubx_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * UBX_KIND_NONE: the spec's default. */
 void ubx_parser_expect(ubx_parser_t *parser, ubx_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

@@ -336,8 +336,8 @@ void vesc_parser_gap(vesc_parser_t *parser);
  * (and while that data is). */
 const uint8_t *vesc_parser_frame(const vesc_parser_t *parser, size_t *len);
 /* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
- * decoded as vesc_decode_expect(..., reply, ...) decodes them where replies share a code; VESC_KIND_NONE: the
- * spec's default. */
+ * decoded as vesc_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * VESC_KIND_NONE: the spec's default. */
 void vesc_parser_expect(vesc_parser_t *parser, vesc_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */

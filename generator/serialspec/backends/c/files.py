@@ -150,8 +150,8 @@ def header(ctx: Ctx) -> str:
         " * a code, so it changes nothing here."
         if protocol.framing.classic
         else "The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are\n"
-        f" * decoded as {p}_decode_expect(..., reply, ...) decodes them where replies share a code; {P}_KIND_NONE: the\n"
-        " * spec's default."
+        f" * decoded as {p}_decode_expect(..., reply, ...) decodes them where replies share a code;\n"
+        f" * {P}_KIND_NONE: the spec's default."
     )
     return f"""{banner(protocol)}
 #ifndef {guard}

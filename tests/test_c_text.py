@@ -139,21 +139,37 @@ def check_decode(b: Built, frame: bytes, direction: str, run: Driver | None = No
         assert answer.startswith("err "), (frame, answer)
 
 
-def python_stream(b: Built, direction: str, data: bytes) -> tuple[list[dict[str, Any]], tuple[int, ...]]:
+def python_stream(
+    b: Built, direction: str, data: bytes, gaps: tuple[int, ...] = ()
+) -> tuple[list[dict[str, Any]], tuple[int, ...]]:
     from serialspec.runtime.text import TextStreamParser
 
     parser = TextStreamParser(b.framing, direction)
     found = []
-    for byte in data:
+    for at, byte in enumerate(data):
+        for _ in range(gaps.count(at)):
+            parser.gap()
         found += [python_json(b, s) for s in parser.feed(bytes([byte]))]
+    for _ in range(sum(1 for at in gaps if at >= len(data))):
+        parser.gap()
     return found, (len(found), 0, parser.corrupt, len(parser.pending()))
 
 
-def stream_agrees(b: Built, direction: str, stream: bytes, sizes: str, run: Driver | None = None) -> None:
-    answers = (run or driver(b.name)).ask(f"stream {direction} {sizes} {stream.hex() or '-'}")
+def stream_agrees(
+    b: Built, direction: str, stream: bytes, sizes: str, run: Driver | None = None, gaps: tuple[int, ...] = ()
+) -> None:
+    """The C parser fed `stream` in pieces of `sizes`, told of a gap in the line before each offset of `gaps`, gives
+    the Python parser's sentences and counters; each one's raw frame (parser_frame) is the stream's next bytes."""
+    where = f" - {','.join(map(str, gaps))}" if gaps else ""
+    answers = (run or driver(b.name)).ask(f"stream {direction} {sizes} {stream.hex() or '-'}{where}")
     messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
     counters = tuple(int(x) for x in answers[-1].split()[1:])
-    assert (messages, counters) == python_stream(b, direction, stream), stream
+    assert (messages, counters) == python_stream(b, direction, stream, gaps), stream
+    at = 0
+    for frame in (bytes.fromhex(a[6:]) for a in answers if a.startswith("frame ")):
+        found = stream.find(frame, at)
+        assert found >= 0 and frame.startswith(b.framing.start.encode()), (frame, stream)
+        at = found + len(frame)
 
 
 def messages_of(b: Built) -> list[tuple[str, TextSentence]]:
@@ -271,6 +287,8 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
             sizes.append(1)
         stream_agrees(b, direction, stream, "1")
         stream_agrees(b, direction, stream, ",".join(map(str, sizes)))
+        gaps = tuple(sorted(data.draw(st.lists(st.integers(0, len(stream)), max_size=4))))
+        stream_agrees(b, direction, stream, ",".join(map(str, sizes)), gaps=gaps)  # the line idle at `gaps`
 
     agree()
 

@@ -14,6 +14,20 @@ void hw_init(hw_parser_t *p);
 int hw_push(hw_parser_t *p, uint8_t b, hw_packet_t *out);
 static hw_parser_t parser;
 static hw_packet_t packet;
+#elif defined(CHECKED)
+typedef struct {
+    uint8_t id, error, data[253];
+    size_t data_len;
+} hc_reply_t;
+typedef struct {
+    size_t n;
+    uint32_t frames, garbage, errors;
+    uint8_t buf[259];
+} hc_parser_t;
+void hc_init(hc_parser_t *p);
+int hc_push(hc_parser_t *p, uint8_t b, hc_reply_t *out);
+static hc_parser_t parser;
+static hc_reply_t reply;
 #elif defined(PROTO)
 #define CAT2(a, b) a##b
 #define CAT(a, b) CAT2(a, b)
@@ -31,6 +45,9 @@ int main(void)
 #ifdef HANDWRITTEN
     hw_init(&parser);
     sink = (uint8_t)hw_push(&parser, sink, &packet);
+#elif defined(CHECKED)
+    hc_init(&parser);
+    sink = (uint8_t)hc_push(&parser, sink, &reply);
 #elif defined(PROTO)
 #if PU(ENABLE_PARSER)
     {

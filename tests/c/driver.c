@@ -3,8 +3,10 @@
  * Built with -DPROTO=<protocol> -include <protocol>_json.h. Commands, each answered by one line (stream: several):
  *   dec DIR HEX [KIND]       decode a frame: "ok <json>" or "err <result>"
  *   rt DIR HEX [KIND]        decode, then encode the message again: "ok <hex>" or "err <result>"
- *   stream DIR SIZES HEX     feed the bytes in pieces of SIZES (comma-separated, repeated): "msg <json>" per message,
- *                            then "end <frames> <garbage> <errors> <held>"
+ *   stream DIR SIZES HEX [KIND|-] [GAPS]
+ *                            feed the bytes in pieces of SIZES (comma-separated, repeated), after parser_expect(KIND)
+ *                            and with parser_gap() at each offset of GAPS (comma-separated, ascending): "msg <json>"
+ *                            and "frame <hex>" (parser_frame) per message, then "end <frames> <garbage> <errors> <held>"
  *   enc1 DIR HEX CAP         decode, then encode into CAP bytes with canary bytes after them: "ok <hex>" / "err <r>"
  *   raw DIR HEX [KIND]       decode: "ok <the msg_t's bytes in hex>" or "err <result>" (for encraw in another build)
  *   encraw DIR HEX           a msg_t from its bytes in hex (raw's, same compiler), encoded: "ok <hex>" / "err <r>"
@@ -133,9 +135,17 @@ int main(void)
         } else if (strcmp(cmd, "stream") == 0) {
             char *sizes = strtok(NULL, " \n");
             char *hex = strtok(NULL, " \n");
+            char *expect = strtok(NULL, " \n");
+            char *gaps = strtok(NULL, " \n");
             size_t n = unhex(hex ? hex : "", frame, sizeof(frame)), at = 0u;
-            size_t piece[64], npieces = 0u, which = 0u;
+            size_t piece[64], npieces = 0u, which = 0u, gap[64], ngaps = 0u, nextgap = 0u;
             char *s = sizes;
+            while (gaps != NULL && *gaps != '\0' && ngaps < 64u) {
+                gap[ngaps++] = (size_t)strtoul(gaps, &gaps, 10);
+                if (*gaps == ',') {
+                    gaps++;
+                }
+            }
             while (s != NULL && *s != '\0' && npieces < 64u) {
                 piece[npieces++] = (size_t)strtoul(s, &s, 10);
                 if (*s == ',') {
@@ -146,12 +156,22 @@ int main(void)
                 piece[npieces++] = 1u;
             }
             P(parser_init)(&parser, dir);
+            if (expect != NULL && strcmp(expect, "-") != 0) {
+                P(parser_expect)(&parser, kind_of(expect));
+            }
             while (at <= n) {
                 size_t take = piece[which++ % npieces];
                 size_t used;
                 bool got;
+                while (nextgap < ngaps && gap[nextgap] <= at) {
+                    P(parser_gap)(&parser);
+                    nextgap++;
+                }
                 if (take > n - at) {
                     take = n - at;
+                }
+                if (nextgap < ngaps && take > gap[nextgap] - at) {
+                    take = gap[nextgap] - at;
                 }
                 /* a piece may hold several messages: feed it until it is used up, then once more with nothing */
                 for (;;) {
@@ -159,8 +179,12 @@ int main(void)
                     at += used;
                     take -= used;
                     if (got) {
+                        size_t flen;
+                        const uint8_t *f = P(parser_frame)(&parser, &flen);
                         P(to_json)(&msg, json, sizeof(json));
-                        printf("msg %s\n", json);
+                        printf("msg %s\nframe ", json);
+                        puthex(f, flen);
+                        printf("\n");
                     }
                     if (!got && take == 0u) {
                         break;
@@ -169,6 +193,10 @@ int main(void)
                 if (at >= n) {
                     break;
                 }
+            }
+            while (nextgap < ngaps) { /* gaps at the stream's end */
+                P(parser_gap)(&parser);
+                nextgap++;
             }
             printf("end %lu %lu %lu %lu\n", (unsigned long)parser.frames, (unsigned long)parser.garbage,
                    (unsigned long)parser.errors, (unsigned long)parser.n);

@@ -2338,7 +2338,7 @@ static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size
             }
             continue;
         }
-        if (crsf_decode(p->buf + pos, (size_t)s, CRSF__RX(p->dir), out) != CRSF_OK) {
+        if (crsf_decode_expect(p->buf + pos, (size_t)s, CRSF__RX(p->dir), p->expect, out) != CRSF_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = CRSF__V_CORRUPT;
             }
@@ -2466,6 +2466,8 @@ static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2517,10 +2519,12 @@ static size_t crsf__whole(crsf_parser_t *p, const uint8_t *data, size_t len, crs
             return 0u;
         }
     }
-    if (crsf_decode(data, size, CRSF__RX(p->dir), out) != CRSF_OK) {
+    if (crsf_decode_expect(data, size, CRSF__RX(p->dir), p->expect, out) != CRSF_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2550,6 +2554,34 @@ size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, 
         }
     }
     return len;
+}
+
+void crsf_parser_gap(crsf_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *crsf_parser_frame(const crsf_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void crsf_parser_expect(crsf_parser_t *parser, crsf_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == CRSF__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

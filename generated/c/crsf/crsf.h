@@ -280,6 +280,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (crsf_parser_frame) */
+    size_t frame_len;
+    crsf_kind_t expect;                 /* crsf_parser_expect */
     uint8_t buf[CRSF_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[CRSF_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } crsf_parser_t;
@@ -312,6 +315,17 @@ int crsf_encode_device_info_response(const crsf_device_info_response_t *m, uint8
  * counters. Work per byte is bounded by CRSF_MAX_FRAME candidate checks, each candidate decoded once. */
 void crsf_parser_init(crsf_parser_t *parser, crsf_direction_t dir);
 size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, crsf_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void crsf_parser_gap(crsf_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the crsf_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *crsf_parser_frame(const crsf_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as crsf_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * CRSF_KIND_NONE: the spec's default. */
+void crsf_parser_expect(crsf_parser_t *parser, crsf_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *crsf_kind_name(crsf_kind_t kind);

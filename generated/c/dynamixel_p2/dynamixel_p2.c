@@ -2024,7 +2024,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
             }
             continue;
         }
-        if (dynamixel_p2_decode(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), out) != DYNAMIXEL_P2_OK) {
+        if (dynamixel_p2_decode_expect(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), p->expect, out) != DYNAMIXEL_P2_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = DYNAMIXEL_P2__V_CORRUPT;
             }
@@ -2152,6 +2152,8 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2203,10 +2205,12 @@ static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (dynamixel_p2_decode(data, size, DYNAMIXEL_P2__RX(p->dir), out) != DYNAMIXEL_P2_OK) {
+    if (dynamixel_p2_decode_expect(data, size, DYNAMIXEL_P2__RX(p->dir), p->expect, out) != DYNAMIXEL_P2_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2236,6 +2240,34 @@ size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *da
         }
     }
     return len;
+}
+
+void dynamixel_p2_parser_gap(dynamixel_p2_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *dynamixel_p2_parser_frame(const dynamixel_p2_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void dynamixel_p2_parser_expect(dynamixel_p2_parser_t *parser, dynamixel_p2_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == DYNAMIXEL_P2__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

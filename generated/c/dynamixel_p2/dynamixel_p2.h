@@ -338,6 +338,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (dynamixel_p2_parser_frame) */
+    size_t frame_len;
+    dynamixel_p2_kind_t expect;                 /* dynamixel_p2_parser_expect */
     uint8_t buf[DYNAMIXEL_P2_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[DYNAMIXEL_P2_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } dynamixel_p2_parser_t;
@@ -371,6 +374,17 @@ int dynamixel_p2_encode_status_response(const dynamixel_p2_status_response_t *m,
  * counters. Work per byte is bounded by DYNAMIXEL_P2_MAX_FRAME candidate checks, each candidate decoded once. */
 void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direction_t dir);
 size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void dynamixel_p2_parser_gap(dynamixel_p2_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the dynamixel_p2_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *dynamixel_p2_parser_frame(const dynamixel_p2_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as dynamixel_p2_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * DYNAMIXEL_P2_KIND_NONE: the spec's default. */
+void dynamixel_p2_parser_expect(dynamixel_p2_parser_t *parser, dynamixel_p2_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *dynamixel_p2_kind_name(dynamixel_p2_kind_t kind);

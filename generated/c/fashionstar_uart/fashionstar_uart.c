@@ -4539,6 +4539,8 @@ static int fashionstar_uart__scan(fashionstar_uart_parser_t *p, fashionstar_uart
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
+                    p->frame = p->buf + pos; /* kept there until the next byte is pushed */
+                    p->frame_len = size;
                     p->n = 0u;
                     p->first = 0u;
                     p->wake = 0u;
@@ -4671,6 +4673,8 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -4700,6 +4704,28 @@ size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uin
         }
     }
     return len;
+}
+
+void fashionstar_uart_parser_gap(fashionstar_uart_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->first = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *fashionstar_uart_parser_frame(const fashionstar_uart_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+void fashionstar_uart_parser_expect(fashionstar_uart_parser_t *parser, fashionstar_uart_kind_t reply)
+{
+    (void)parser;
+    (void)reply;
 }
 #endif
 

@@ -548,6 +548,8 @@ typedef struct {
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
+    const uint8_t *frame;             /* the last frame delivered, as received (fashionstar_uart_parser_frame) */
+    size_t frame_len;
     uint8_t buf[FASHIONSTAR_UART_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[FASHIONSTAR_UART_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, 3 corrupt */
 } fashionstar_uart_parser_t;
@@ -606,6 +608,16 @@ int fashionstar_uart_encode_sync_command_request(const fashionstar_uart_sync_com
  * counters. Work per byte is bounded by FASHIONSTAR_UART_MAX_FRAME candidate checks, each candidate decoded once. */
 void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar_uart_direction_t dir);
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void fashionstar_uart_parser_gap(fashionstar_uart_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the fashionstar_uart_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *fashionstar_uart_parser_frame(const fashionstar_uart_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's StreamParser.expect()): classic frames have one layout
+ * a code, so it changes nothing here. */
+void fashionstar_uart_parser_expect(fashionstar_uart_parser_t *parser, fashionstar_uart_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *fashionstar_uart_kind_name(fashionstar_uart_kind_t kind);

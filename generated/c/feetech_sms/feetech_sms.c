@@ -1652,6 +1652,8 @@ static int feetech_sms__scan(feetech_sms_parser_t *p, feetech_sms_msg_t *out)
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
+                    p->frame = p->buf + pos; /* kept there until the next byte is pushed */
+                    p->frame_len = size;
                     p->n = 0u;
                     p->first = 0u;
                     p->wake = 0u;
@@ -1784,6 +1786,8 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -1813,6 +1817,28 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
         }
     }
     return len;
+}
+
+void feetech_sms_parser_gap(feetech_sms_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->first = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *feetech_sms_parser_frame(const feetech_sms_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+void feetech_sms_parser_expect(feetech_sms_parser_t *parser, feetech_sms_kind_t reply)
+{
+    (void)parser;
+    (void)reply;
 }
 #endif
 

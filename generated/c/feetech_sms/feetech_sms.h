@@ -238,6 +238,8 @@ typedef struct {
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
+    const uint8_t *frame;             /* the last frame delivered, as received (feetech_sms_parser_frame) */
+    size_t frame_len;
     uint8_t buf[FEETECH_SMS_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[FEETECH_SMS_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, 3 corrupt */
 } feetech_sms_parser_t;
@@ -265,6 +267,16 @@ int feetech_sms_encode_reply_response(const feetech_sms_reply_response_t *m, uin
  * counters. Work per byte is bounded by FEETECH_SMS_MAX_FRAME candidate checks, each candidate decoded once. */
 void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction_t dir);
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void feetech_sms_parser_gap(feetech_sms_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the feetech_sms_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *feetech_sms_parser_frame(const feetech_sms_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's StreamParser.expect()): classic frames have one layout
+ * a code, so it changes nothing here. */
+void feetech_sms_parser_expect(feetech_sms_parser_t *parser, feetech_sms_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *feetech_sms_kind_name(feetech_sms_kind_t kind);

@@ -4459,6 +4459,8 @@ static int hiwonder_rrc__scan(hiwonder_rrc_parser_t *p, hiwonder_rrc_msg_t *out)
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
+                    p->frame = p->buf + pos; /* kept there until the next byte is pushed */
+                    p->frame_len = size;
                     p->n = 0u;
                     p->first = 0u;
                     p->wake = 0u;
@@ -4591,6 +4593,8 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -4620,6 +4624,28 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
         }
     }
     return len;
+}
+
+void hiwonder_rrc_parser_gap(hiwonder_rrc_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->first = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *hiwonder_rrc_parser_frame(const hiwonder_rrc_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+void hiwonder_rrc_parser_expect(hiwonder_rrc_parser_t *parser, hiwonder_rrc_kind_t reply)
+{
+    (void)parser;
+    (void)reply;
 }
 #endif
 

@@ -598,6 +598,8 @@ typedef struct {
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
+    const uint8_t *frame;             /* the last frame delivered, as received (hiwonder_rrc_parser_frame) */
+    size_t frame_len;
     uint8_t buf[HIWONDER_RRC_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[HIWONDER_RRC_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, 3 corrupt */
 } hiwonder_rrc_parser_t;
@@ -665,6 +667,16 @@ int hiwonder_rrc_encode_rgb_set_pixels_request(const hiwonder_rrc_rgb_set_pixels
  * counters. Work per byte is bounded by HIWONDER_RRC_MAX_FRAME candidate checks, each candidate decoded once. */
 void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direction_t dir);
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void hiwonder_rrc_parser_gap(hiwonder_rrc_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the hiwonder_rrc_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *hiwonder_rrc_parser_frame(const hiwonder_rrc_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's StreamParser.expect()): classic frames have one layout
+ * a code, so it changes nothing here. */
+void hiwonder_rrc_parser_expect(hiwonder_rrc_parser_t *parser, hiwonder_rrc_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *hiwonder_rrc_kind_name(hiwonder_rrc_kind_t kind);

@@ -2730,7 +2730,7 @@ static int mavlink_common__try(mavlink_common_parser_t *p, size_t pos, mavlink_c
             }
             continue;
         }
-        if (mavlink_common_decode(p->buf + pos, (size_t)s, MAVLINK_COMMON__RX(p->dir), out) != MAVLINK_COMMON_OK) {
+        if (mavlink_common_decode_expect(p->buf + pos, (size_t)s, MAVLINK_COMMON__RX(p->dir), p->expect, out) != MAVLINK_COMMON_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MAVLINK_COMMON__V_CORRUPT;
             }
@@ -2858,6 +2858,8 @@ static int mavlink_common__push(mavlink_common_parser_t *p, uint8_t byte, mavlin
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2909,10 +2911,12 @@ static size_t mavlink_common__whole(mavlink_common_parser_t *p, const uint8_t *d
             return 0u;
         }
     }
-    if (mavlink_common_decode(data, size, MAVLINK_COMMON__RX(p->dir), out) != MAVLINK_COMMON_OK) {
+    if (mavlink_common_decode_expect(data, size, MAVLINK_COMMON__RX(p->dir), p->expect, out) != MAVLINK_COMMON_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2942,6 +2946,34 @@ size_t mavlink_common_parser_feed(mavlink_common_parser_t *parser, const uint8_t
         }
     }
     return len;
+}
+
+void mavlink_common_parser_gap(mavlink_common_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *mavlink_common_parser_frame(const mavlink_common_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void mavlink_common_parser_expect(mavlink_common_parser_t *parser, mavlink_common_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == MAVLINK_COMMON__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

@@ -401,6 +401,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (mavlink_common_parser_frame) */
+    size_t frame_len;
+    mavlink_common_kind_t expect;                 /* mavlink_common_parser_expect */
     uint8_t buf[MAVLINK_COMMON_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[MAVLINK_COMMON_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } mavlink_common_parser_t;
@@ -428,6 +431,17 @@ int mavlink_common_encode_command_ack_response(const mavlink_common_command_ack_
  * counters. Work per byte is bounded by MAVLINK_COMMON_MAX_FRAME candidate checks, each candidate decoded once. */
 void mavlink_common_parser_init(mavlink_common_parser_t *parser, mavlink_common_direction_t dir);
 size_t mavlink_common_parser_feed(mavlink_common_parser_t *parser, const uint8_t *data, size_t len, mavlink_common_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void mavlink_common_parser_gap(mavlink_common_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the mavlink_common_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *mavlink_common_parser_frame(const mavlink_common_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as mavlink_common_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * MAVLINK_COMMON_KIND_NONE: the spec's default. */
+void mavlink_common_parser_expect(mavlink_common_parser_t *parser, mavlink_common_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *mavlink_common_kind_name(mavlink_common_kind_t kind);

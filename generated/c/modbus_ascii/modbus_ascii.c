@@ -2594,7 +2594,7 @@ static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_
             }
             continue;
         }
-        if (modbus_ascii_decode(p->buf + pos, (size_t)s, MODBUS_ASCII__RX(p->dir), out) != MODBUS_ASCII_OK) {
+        if (modbus_ascii_decode_expect(p->buf + pos, (size_t)s, MODBUS_ASCII__RX(p->dir), p->expect, out) != MODBUS_ASCII_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_ASCII__V_CORRUPT;
             }
@@ -2722,6 +2722,8 @@ static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_asc
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2773,10 +2775,12 @@ static size_t modbus_ascii__whole(modbus_ascii_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (modbus_ascii_decode(data, size, MODBUS_ASCII__RX(p->dir), out) != MODBUS_ASCII_OK) {
+    if (modbus_ascii_decode_expect(data, size, MODBUS_ASCII__RX(p->dir), p->expect, out) != MODBUS_ASCII_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2806,6 +2810,34 @@ size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *da
         }
     }
     return len;
+}
+
+void modbus_ascii_parser_gap(modbus_ascii_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *modbus_ascii_parser_frame(const modbus_ascii_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void modbus_ascii_parser_expect(modbus_ascii_parser_t *parser, modbus_ascii_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == MODBUS_ASCII__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

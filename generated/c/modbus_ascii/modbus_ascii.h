@@ -334,6 +334,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (modbus_ascii_parser_frame) */
+    size_t frame_len;
+    modbus_ascii_kind_t expect;                 /* modbus_ascii_parser_expect */
     uint8_t buf[MODBUS_ASCII_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[MODBUS_ASCII_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } modbus_ascii_parser_t;
@@ -373,6 +376,17 @@ int modbus_ascii_encode_exception_response(const modbus_ascii_exception_response
  * counters. Work per byte is bounded by MODBUS_ASCII_MAX_FRAME candidate checks, each candidate decoded once. */
 void modbus_ascii_parser_init(modbus_ascii_parser_t *parser, modbus_ascii_direction_t dir);
 size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *data, size_t len, modbus_ascii_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void modbus_ascii_parser_gap(modbus_ascii_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the modbus_ascii_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *modbus_ascii_parser_frame(const modbus_ascii_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as modbus_ascii_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * MODBUS_ASCII_KIND_NONE: the spec's default. */
+void modbus_ascii_parser_expect(modbus_ascii_parser_t *parser, modbus_ascii_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *modbus_ascii_kind_name(modbus_ascii_kind_t kind);

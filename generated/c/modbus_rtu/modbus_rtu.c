@@ -2619,7 +2619,7 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
             }
             continue;
         }
-        if (modbus_rtu_decode(p->buf + pos, (size_t)s, MODBUS_RTU__RX(p->dir), out) != MODBUS_RTU_OK) {
+        if (modbus_rtu_decode_expect(p->buf + pos, (size_t)s, MODBUS_RTU__RX(p->dir), p->expect, out) != MODBUS_RTU_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_RTU__V_CORRUPT;
             }
@@ -2747,6 +2747,8 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2798,10 +2800,12 @@ static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, siz
             return 0u;
         }
     }
-    if (modbus_rtu_decode(data, size, MODBUS_RTU__RX(p->dir), out) != MODBUS_RTU_OK) {
+    if (modbus_rtu_decode_expect(data, size, MODBUS_RTU__RX(p->dir), p->expect, out) != MODBUS_RTU_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2831,6 +2835,34 @@ size_t modbus_rtu_parser_feed(modbus_rtu_parser_t *parser, const uint8_t *data, 
         }
     }
     return len;
+}
+
+void modbus_rtu_parser_gap(modbus_rtu_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *modbus_rtu_parser_frame(const modbus_rtu_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void modbus_rtu_parser_expect(modbus_rtu_parser_t *parser, modbus_rtu_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == MODBUS_RTU__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

@@ -1933,6 +1933,8 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
             nmea0183__drop(p, end + k);
             if (r == NMEA0183_OK) {
                 p->frames++;
+                p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
+                p->frame_len = end + k;
                 return 1;
             }
             p->errors++;
@@ -1947,6 +1949,16 @@ void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;
+    parser->frame = NULL;
+    parser->frame_len = 0u;
+}
+
+void nmea0183_parser_gap(nmea0183_parser_t *parser)
+{
+    if (parser->n > 0u) { /* it begins with the start character */
+        parser->errors++;
+    }
+    parser->n = 0u;
 }
 
 size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size_t len, nmea0183_msg_t *out, bool *got)
@@ -1957,6 +1969,20 @@ size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size
     if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
         return len;
     }
+
+const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
+{
+    (void)parser;
+    (void)reply;
+}
 #endif
     for (i = 0u; i < len; i++) {
         if (nmea0183__push(parser, data[i], out)) {
@@ -1965,6 +1991,20 @@ size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size
         }
     }
     return len;
+}
+
+const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
+{
+    (void)parser;
+    (void)reply;
 }
 #endif
 

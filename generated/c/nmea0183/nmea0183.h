@@ -303,6 +303,8 @@ typedef struct {
     uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
+    const uint8_t *frame; /* the last frame delivered, as received (nmea0183_parser_frame) */
+    size_t frame_len;
 } nmea0183_parser_t;
 
 /* The checksum of the characters between start and marker. */
@@ -315,6 +317,15 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
 int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir);
 size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size_t len, nmea0183_msg_t *out, bool *got);
+/* The line went idle: no frame spans a gap, so a frame begun is dropped as cut short (counted in errors), as Python's
+ * TextStreamParser.gap() does. */
+void nmea0183_parser_gap(nmea0183_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), in the parser's buffer: valid until the
+ * next call on the parser. */
+const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len);
+/* The reply the next frames answer: Python's TextStreamParser reads each frame by its text code alone, so it changes
+ * nothing (there for the same API as a binary protocol's). */
+void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply);
 const char *nmea0183_kind_name(nmea0183_kind_t kind);
 const char *nmea0183_result_name(int result);
 

@@ -2332,7 +2332,7 @@ static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
             }
             continue;
         }
-        if (ubx_decode(p->buf + pos, (size_t)s, UBX__RX(p->dir), out) != UBX_OK) {
+        if (ubx_decode_expect(p->buf + pos, (size_t)s, UBX__RX(p->dir), p->expect, out) != UBX_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = UBX__V_CORRUPT;
             }
@@ -2460,6 +2460,8 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2511,10 +2513,12 @@ static size_t ubx__whole(ubx_parser_t *p, const uint8_t *data, size_t len, ubx_m
             return 0u;
         }
     }
-    if (ubx_decode(data, size, UBX__RX(p->dir), out) != UBX_OK) {
+    if (ubx_decode_expect(data, size, UBX__RX(p->dir), p->expect, out) != UBX_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2544,6 +2548,34 @@ size_t ubx_parser_feed(ubx_parser_t *parser, const uint8_t *data, size_t len, ub
         }
     }
     return len;
+}
+
+void ubx_parser_gap(ubx_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *ubx_parser_frame(const ubx_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void ubx_parser_expect(ubx_parser_t *parser, ubx_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == UBX__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

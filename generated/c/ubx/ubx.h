@@ -304,6 +304,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (ubx_parser_frame) */
+    size_t frame_len;
+    ubx_kind_t expect;                 /* ubx_parser_expect */
     uint8_t buf[UBX_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[UBX_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } ubx_parser_t;
@@ -336,6 +339,17 @@ int ubx_encode_mon_ver_response(const ubx_mon_ver_response_t *m, uint8_t *buf, s
  * counters. Work per byte is bounded by UBX_MAX_FRAME candidate checks, each candidate decoded once. */
 void ubx_parser_init(ubx_parser_t *parser, ubx_direction_t dir);
 size_t ubx_parser_feed(ubx_parser_t *parser, const uint8_t *data, size_t len, ubx_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void ubx_parser_gap(ubx_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the ubx_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *ubx_parser_frame(const ubx_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as ubx_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * UBX_KIND_NONE: the spec's default. */
+void ubx_parser_expect(ubx_parser_t *parser, ubx_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *ubx_kind_name(ubx_kind_t kind);

@@ -2306,7 +2306,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
             }
             continue;
         }
-        if (vesc_decode(p->buf + pos, (size_t)s, VESC__RX(p->dir), out) != VESC_OK) {
+        if (vesc_decode_expect(p->buf + pos, (size_t)s, VESC__RX(p->dir), p->expect, out) != VESC_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = VESC__V_CORRUPT;
             }
@@ -2434,6 +2434,8 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }
         start = pos + 1u;
@@ -2485,10 +2487,12 @@ static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, ves
             return 0u;
         }
     }
-    if (vesc_decode(data, size, VESC__RX(p->dir), out) != VESC_OK) {
+    if (vesc_decode_expect(data, size, VESC__RX(p->dir), p->expect, out) != VESC_OK) {
         return 0u;
     }
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }
 #endif
@@ -2518,6 +2522,34 @@ size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, 
         }
     }
     return len;
+}
+
+void vesc_parser_gap(vesc_parser_t *parser)
+{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}
+
+const uint8_t *vesc_parser_frame(const vesc_parser_t *parser, size_t *len)
+{
+    if (len != NULL) {
+        *len = parser->frame_len;
+    }
+    return parser->frame;
+}
+
+
+void vesc_parser_expect(vesc_parser_t *parser, vesc_kind_t reply)
+{
+    size_t i;
+    parser->expect = reply;
+    for (i = 0u; i < parser->n; i++) {
+        if (parser->verdict[i] == VESC__V_CORRUPT) { /* corrupt as another reply: judged again */
+            parser->verdict[i] = 0u;
+        }
+    }
+    parser->wake = 0u;
 }
 #endif
 

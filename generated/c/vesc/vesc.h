@@ -293,6 +293,9 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    const uint8_t *frame;             /* the last frame delivered, as received (vesc_parser_frame) */
+    size_t frame_len;
+    vesc_kind_t expect;                 /* vesc_parser_expect */
     uint8_t buf[VESC_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[VESC_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 } vesc_parser_t;
@@ -325,6 +328,17 @@ int vesc_encode_forward_can_request(const vesc_forward_can_request_t *m, uint8_t
  * counters. Work per byte is bounded by VESC_MAX_FRAME candidate checks, each candidate decoded once. */
 void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir);
 size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, vesc_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void vesc_parser_gap(vesc_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the vesc_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *vesc_parser_frame(const vesc_parser_t *parser, size_t *len);
+/* The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are
+ * decoded as vesc_decode_expect(..., reply, ...) decodes them where replies share a code;
+ * VESC_KIND_NONE: the spec's default. */
+void vesc_parser_expect(vesc_parser_t *parser, vesc_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *vesc_kind_name(vesc_kind_t kind);

@@ -1058,6 +1058,11 @@ class FrameStreamParser(StreamParser):
                 best = (position + size, decode, verify) if position + size <= end else (position + size, None, None)
         return best
 
+    def gap(self) -> None:
+        """The line went idle: the bytes held are dropped as garbage (StreamParser.gap)."""
+        self.garbage += len(self._pending)
+        self._pending = b""
+
     def pending(self) -> bytes:
         return self._pending
 

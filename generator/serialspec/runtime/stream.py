@@ -765,6 +765,15 @@ class StreamParser:
         """The reply class the next frames answer (and the request they answer); classic frames have one layout
         per code, so it changes nothing."""
 
+    def gap(self) -> None:
+        """The line went idle (a Modbus 3.5-character pause, a UART IDLE interrupt, a read that timed out): no frame
+        spans it, so the bytes held (candidates waiting for bytes that will not come, a tail that could begin a
+        header) are dropped and counted as garbage. The bytes held never hold a complete frame: it would have been
+        taken."""
+        self.garbage += len(self._pending)
+        self._pending = b""
+        self._need = 0
+
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""
         return self._pending

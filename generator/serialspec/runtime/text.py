@@ -662,6 +662,14 @@ class TextStreamParser:
         self.corrupt += 1
         self.last_error = reason
 
+    def gap(self) -> None:
+        """The line went idle: no frame spans it. A frame begun (its start character read; frames without one: a line
+        with more than blanks) is dropped as cut short, counted in `corrupt`; the line ending that follows is noise."""
+        begun = self._buffer.startswith(self._start) if self._start else bool(self._buffer.strip(b"\r\n"))
+        if begun and not self._overlong:
+            self._dropped("text frame cut short by a gap in the line")
+        self._buffer, self._overlong = b"", False
+
     def pending(self) -> bytes:
         return self._buffer
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from serialspec import __version__
-from serialspec.backends.c import length_byte, optional, packed
+from serialspec.backends.c import length_byte, optional, packed, parser_api
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
@@ -140,6 +140,19 @@ def header(ctx: Ctx) -> str:
     )
     checks = "\n".join(dict.fromkeys(c.prototype for _, c in ctx.checks))
     guard = f"{P}_H"
+    # Python's StreamParser of classic frames has one layout per code and ignores expect(); FrameStreamParser's
+    # decodes the frames it takes as the expected reply (replies that share a code)
+    expect_member = (
+        "" if protocol.framing.classic else f"    {p}_kind_t expect;                 /* {p}_parser_expect */\n"
+    )
+    expect_doc = (
+        "The reply the next frames answer (Python's StreamParser.expect()): classic frames have one layout\n"
+        " * a code, so it changes nothing here."
+        if protocol.framing.classic
+        else "The reply the next frames answer (Python's FrameStreamParser.expect()): the frames it takes are\n"
+        f" * decoded as {p}_decode_expect(..., reply, ...) decodes them where replies share a code;\n"
+        f" * {P}_KIND_NONE: the spec's default."
+    )
     return f"""{banner(protocol)}
 #ifndef {guard}
 #define {guard}
@@ -227,7 +240,9 @@ typedef struct {{
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
 {wake}
-    uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
+    const uint8_t *frame;             /* the last frame delivered, as received ({p}_parser_frame) */
+    size_t frame_len;
+{expect_member}    uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
 {verdict}
 }} {p}_parser_t;
 
@@ -246,6 +261,15 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
  * counters. Work per byte is bounded by {P}_MAX_FRAME candidate checks, each candidate decoded once. */
 void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir);
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got);
+/* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
+ * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
+void {p}_parser_gap({p}_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), for routing: they lie in the parser's
+ * buffer or in the data given to the {p}_parser_feed call that delivered it; valid until the next call on the parser
+ * (and while that data is). */
+const uint8_t *{p}_parser_frame(const {p}_parser_t *parser, size_t *len);
+/* {expect_doc} */
+void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply);
 
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *{p}_kind_name({p}_kind_t kind);
@@ -1207,6 +1231,11 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 #endif
 
 """
+    classic = protocol.framing.classic
+    decode_rx = f"{p}_decode" if classic else f"{p}_decode_expect"
+    expect_arg = "" if classic else "p->expect, "
+    parser_common = parser_api.frame_function(p)
+    expect_function = parser_api.expect_function(p, P, classic)
     parsing = f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
 
@@ -1245,7 +1274,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
             }}
             continue;
         }}
-        if ({p}_decode(p->buf + pos, (size_t)s, {P}__RX(p->dir), out) != {P}_OK) {{
+        if ({decode_rx}(p->buf + pos, (size_t)s, {P}__RX(p->dir), {expect_arg}out) != {P}_OK) {{
             if (need == (size_t)-1) {{
                 p->verdict[pos] = {P}__V_CORRUPT;
             }}
@@ -1373,6 +1402,8 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
             start = done = pos + size;
             got = 1;
             p->frames++;
+            p->frame = p->buf + pos; /* it ends with the byte just pushed: nothing held after it moves over it */
+            p->frame_len = size;
             break;
         }}
         start = pos + 1u;
@@ -1424,10 +1455,12 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
             return 0u;
         }}
     }}
-    if ({p}_decode(data, size, {P}__RX(p->dir), out) != {P}_OK) {{
+    if ({decode_rx}(data, size, {P}__RX(p->dir), {expect_arg}out) != {P}_OK) {{
         return 0u;
     }}
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }}
 #endif
@@ -1458,7 +1491,15 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
     }}
     return len;
 }}
-#endif
+
+void {p}_parser_gap({p}_parser_t *parser)
+{{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->wake = 0u;
+}}
+{parser_common}
+{expect_function}#endif
 """
     tail = f"""
 const char *{p}_kind_name({p}_kind_t kind)

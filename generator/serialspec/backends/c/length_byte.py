@@ -16,6 +16,7 @@ Every other framing takes the general parser.
 
 from __future__ import annotations
 
+from serialspec.backends.c import parser_api
 from serialspec.backends.c.emit import Ctx
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Protocol
 
@@ -204,6 +205,8 @@ static int {p}__scan({p}_parser_t *p, {p}_msg_t *out)
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
+                    p->frame = p->buf + pos; /* kept there until the next byte is pushed */
+                    p->frame_len = size;
                     p->n = 0u;
                     p->first = 0u;
                     p->wake = 0u;
@@ -336,6 +339,8 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
         return 0u;
     }}
     p->frames++;
+    p->frame = data;
+    p->frame_len = size;
     return size;
 }}
 #endif
@@ -366,5 +371,13 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
     }}
     return len;
 }}
-#endif
+
+void {p}_parser_gap({p}_parser_t *parser)
+{{
+    parser->garbage += (uint32_t)parser->n;
+    parser->n = 0u;
+    parser->first = 0u;
+    parser->wake = 0u;
+}}
+{parser_api.frame_function(p)}{parser_api.expect_function(p, P, True)}#endif
 """

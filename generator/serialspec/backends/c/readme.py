@@ -123,6 +123,12 @@ def readme(ctx: Ctx) -> str:
         f"| `{p}_parser_init(&parser, dir)` | a stream parser; its state is the caller's `{p}_parser_t` |",
         f"| `{p}_parser_feed(&parser, data, len, &msg, &got)` | bytes in as they come; returns how many it took, "
         "`got` when a message came out (call again with the rest, or with 0 bytes, for more) |",
+        f"| `{p}_parser_gap(&parser)` | the line went idle (a UART IDLE interrupt, a timeout): the bytes held are "
+        "dropped, as no frame spans a gap |",
+        f"| `{p}_parser_frame(&parser, &len)` | the raw bytes of the last message's frame, for routing (valid until "
+        "the next call on the parser) |",
+        f"| `{p}_parser_expect(&parser, kind)` | the reply the next frames answer, where replies share a code (as "
+        f"`{p}_decode_expect`) |",
         f"| `{p}_to_json(&msg, out, cap)` | `{p}_json.h`: the message as `serialspec decode --json` writes it, "
         "snprintf-like |",
         f"| `{p}_kind_name(kind)`, `{p}_result_name(result)` | names |",

@@ -10,6 +10,7 @@ from decimal import Decimal
 from typing import assert_never
 
 from serialspec.backends import Unsupported
+from serialspec.backends.c import parser_api
 from serialspec.backends.c.emit import comment, ident, spec_hash
 from serialspec.backends.c.files import role_macros
 from serialspec.backends.c.text_runtime import BEFORE_PARSER, CHECKED_READ, CHECKED_WRITE, HEAD, MIDDLE, PARSER
@@ -223,6 +224,8 @@ typedef struct {{
     uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
+    const uint8_t *frame; /* the last frame delivered, as received ({p}_parser_frame) */
+    size_t frame_len;
 }} {p}_parser_t;
 
 {check}int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out);
@@ -233,6 +236,15 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir);
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got);
+/* The line went idle: no frame spans a gap, so a frame begun is dropped as cut short (counted in errors), as Python's
+ * TextStreamParser.gap() does. */
+void {p}_parser_gap({p}_parser_t *parser);
+/* The raw bytes of the last frame delivered (NULL and 0 before the first), in the parser's buffer: valid until the
+ * next call on the parser. */
+const uint8_t *{p}_parser_frame(const {p}_parser_t *parser, size_t *len);
+/* The reply the next frames answer: Python's TextStreamParser reads each frame by its text code alone, so it changes
+ * nothing (there for the same API as a binary protocol's). */
+void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply);
 const char *{p}_kind_name({p}_kind_t kind);
 const char *{p}_result_name(int result);
 
@@ -445,7 +457,14 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 """
         parts = (HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER) if checked else (HEAD, MIDDLE, BEFORE_PARSER)
         runtime = "".join(parts).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")  # the checksum's code: if any
-        parser = PARSER.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
+        parser = (
+            PARSER.replace("PFX_", f"{P}_")
+            .replace("pfx_", f"{p}_")
+            .replace(
+                "}\n#endif\n",
+                "}\n" + parser_api.frame_function(p) + parser_api.expect_function(p, P, True) + "#endif\n",
+            )
+        )
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}

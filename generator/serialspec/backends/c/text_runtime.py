@@ -595,6 +595,8 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
             pfx__drop(p, end + k);
             if (r == PFX_OK) {
                 p->frames++;
+                p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
+                p->frame_len = end + k;
                 return 1;
             }
             p->errors++;
@@ -609,6 +611,16 @@ void pfx_parser_init(pfx_parser_t *parser, pfx_direction_t dir)
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;
+    parser->frame = NULL;
+    parser->frame_len = 0u;
+}
+
+void pfx_parser_gap(pfx_parser_t *parser)
+{
+    if (parser->n > 0u) { /* it begins with the start character */
+        parser->errors++;
+    }
+    parser->n = 0u;
 }
 
 size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pfx_msg_t *out, bool *got)

@@ -715,6 +715,41 @@ CASES[BY_COMMAND] = Case(
 )
 # each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
 C_REFUSES[BY_COMMAND] = WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
+# Layouts chosen by command, one with a command element and one without (TFmini: configuration frames 42 57 02 00,
+# parameters, the command byte last; data frames 59 59 with no command): a codeless command travels in its own layout
+MIXED = "frame: layouts chosen by command, one without a command element, the command byte after the content"
+CASES[MIXED] = Case(
+    {"v": "u16"},
+    {"v": "u16", "on": {"type": "u8", "range": [0, 1]}},
+    {
+        "layouts": {
+            "config": {
+                "elements": {
+                    "header": {"role": "header", "value": {"request": "42 57 02 00", "response": "42 57 02 01"}},
+                    "content": {"role": "content"},
+                    "code": {"role": "command", "type": "u8"},
+                }
+            },
+            "data": {
+                "elements": {
+                    "header": {"role": "header", "value": "59 59"},
+                    "content": {"role": "content"},
+                    "sum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["header", "content"]},
+                }
+            },
+        }
+    },
+    commands={
+        "mode": {
+            "code": 0x11,
+            "layout": "config",
+            "request": {"fields": {"m": "u8"}},
+            "response": {"fields": {"m": "u8"}},
+        },
+        "measure": {"layout": "data", "request": {}, "response": {"fields": {"distance": "u16", "strength": "u16"}}},
+    },
+)
+C_REFUSES[MIXED] = WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
 
 
 # `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
@@ -958,8 +993,10 @@ SETTINGS = settings(max_examples=examples(8), deadline=None, suppress_health_che
 
 
 def requesting(g: Generated) -> bool:
-    """Replies are read with the request they answer (layouts chosen by command, a checksum over request bytes)."""
-    return g.protocol.framing.by_command or g.protocol.framing.from_request
+    """Replies are read with the request they answer (codeless replies in layouts chosen by command, a checksum over
+    request bytes)."""
+    framing = g.protocol.framing
+    return any(framing.by_request(d) for d in framing.alternatives) or framing.from_request
 
 
 def asked(g: Generated, message: Message) -> Any:

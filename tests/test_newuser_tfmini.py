@@ -1,8 +1,8 @@
 """Benewake TFmini data frames (tests/specs/tfmini.yaml), written from the user docs alone and checked against
 Adafruit's TFmini driver (adafruit-circuitpython-tfmini, which takes a pyserial port): it reads the frames we encode
 and the ones `serialspec sim` streams, and our decoder reads frames built by the driver's own unpacking rules. The
-configuration commands are left out of the spec: the language cannot describe them beside the data frames (the strict
-xfail below)."""
+configuration commands (a second layout, the command byte after the parameters) are added below, each command naming
+its layout (`layout:`)."""
 
 from __future__ import annotations
 
@@ -130,16 +130,47 @@ def test_layouts_that_differ_in_having_a_command_are_one_line_naming_them(tmp_pa
     assert len(lines) == 1, lines
     assert lines[0].endswith(
         ": framing.layouts: alternative layouts must all have a command element or none (config has one, data has none)"
+        ", unless each command names its layout (`layout:`)"
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding: layouts must all have a command element or none; the TFmini's data frames (59 59, no command) "
-    "and its configuration frames (42 57 02 00, parameters, command byte last) cannot share a spec",
-)
+def by_layout(spec: Path) -> Path:
+    """The full spec with each command naming its layout (`layout:`): the data frames carry no command byte, the
+    configuration frames one after their parameters."""
+    text = spec.read_text("utf-8")
+    text = text.replace("  measurement:\n", "  measurement:\n    layout: data\n", 1)
+    for code in ("0x02", "0x11"):
+        text = text.replace(f"    code: {code}\n", f"    code: {code}\n    layout: config\n", 1)
+    spec.write_text(text, "utf-8")
+    return spec
+
+
 def test_the_configuration_commands_beside_the_data_frames(tmp_path: Path) -> None:
+    """Found writing this spec (issue 21): with `layout:` on each command, the data frames (59 59, no command byte)
+    and the configuration frames (42 57 02 00, parameters, the command byte last) share one spec; each frame is told
+    apart by its header, read whole by the stream parser however the bytes come, and the driver still reads the data
+    frames among configuration echoes."""
     from serialspec.lang import load_protocol
 
-    protocol = load_protocol(str(full_spec(tmp_path)), "tfmini.yaml")
+    spec = by_layout(full_spec(tmp_path))
+    protocol = load_protocol(str(spec), "tfmini.yaml")
     assert {c.name for c in protocol.commands} >= {"measurement", "config_mode", "set_mode"}
+    spec.write_text(spec.read_text("utf-8").replace("protocol: tfmini\n", "protocol: tfmini_full\n"), "utf-8")
+    tf = generate_and_import(spec, tmp_path / "out", "tfmini_full")  # not the data frames' package of the fixture
+    assert tf.encode(tf.SetModeRequest(mode=tf.Mode.LONG)) == bytes.fromhex("42 57 02 00 00 00 07 11")
+    assert tf.encode(tf.ConfigModeResponse(enter=1)) == bytes.fromhex("42 57 02 01 00 00 01 02")
+    data = driver_frame(100, 800, 2, 0)
+    assert tf.decode(data, tf.Direction.RESPONSE) == tf.MeasurementResponse(distance=100, strength=800, mode=2, spare=0)
+    echoes = [tf.SetModeResponse(mode=tf.Mode.SHORT), tf.ConfigModeResponse(enter=0)]
+    stream = data + tf.encode(echoes[0]) + data + tf.encode(echoes[1]) + data
+    for size in range(1, len(stream) + 1):
+        parser, got = tf.StreamParser(tf.Direction.RESPONSE), []
+        for at in range(0, len(stream), size):
+            got += parser.feed(stream[at : at + size])
+        assert [type(m) for m in got] == [
+            tf.MeasurementResponse,
+            tf.SetModeResponse,
+            tf.MeasurementResponse,
+            tf.ConfigModeResponse,
+            tf.MeasurementResponse,
+        ], size

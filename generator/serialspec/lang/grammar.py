@@ -585,7 +585,12 @@ COMMAND = Obj(
             "code are read in the layout of the request they answer: `decode` and `encode` refuse such a reply in "
             "one line without it (`--request HEX`), the stream parser takes none while no request is pending, and "
             "the client and the simulator give it. A layout may be constant bytes alone (RoboClaw's 0xFF "
-            "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`). The C and Wireshark "
+            "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`). Layouts chosen by command "
+            "may differ in having a command element: a command without `code` travels in a layout without one, its "
+            "frames told apart by their header (TFmini: data frames `59 59` with no command byte, `measurement: "
+            "{layout: data}`, beside configuration frames `42 57 02 00`, parameters, the command byte last, "
+            "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
+            "with no length, is found by trying each code's size. The C and Wireshark "
             "targets, which read each frame alone, refuse such a spec in one line (`layouts chosen by command`).",
             example="read",
         ),
@@ -914,7 +919,8 @@ FRAMING = Obj(
                 description="One alternative layout: its elements in wire order.",
             ),
             "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
-            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length).",
+            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length). They all have a command "
+            "element or none, unless each command names its layout (`layout:`).",
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),

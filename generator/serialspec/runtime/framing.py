@@ -707,6 +707,8 @@ class FrameCodec:
                 return -1
         if layout.content < 0 and layout.transparency is None:
             return layout.overhead  # its fixed elements alone (a bare acknowledgement)
+        if code is None and self._trailing(layout) is not None:
+            return self._by_trailing_code(layout, buffer, start, end)
         low, high = self.content_sizes.get(code, (0, None))
         if plan["probe_inner"] is not None:
             return _inner_size(layout, plan, buffer, start, end, low, high)
@@ -729,6 +731,32 @@ class FrameCodec:
         if content_size < low or (high is not None and content_size > high):
             return -1
         return layout.overhead + content_size
+
+    def _trailing(self, layout: Layout) -> tuple[int, int] | None:
+        """Where a command element after the content sits, counted from the frame's end (start, stop), for a
+        layout that has no length, terminator or stuffing to size its frames by; None otherwise."""
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        if layout.transparency is not None or layout.trailer or plan["probe_length"] is not None:
+            return None
+        return next(((a, b) for index, a, b in plan["tail"] if index == layout.command), None)
+
+    def _by_trailing_code(self, layout: Layout, buffer: bytes, start: int, end: int) -> int | None:
+        """Size of a frame whose command element follows a content of one size per code (TFmini's configuration
+        frames): the smallest frame with the code of its size in the command element; None while a candidate size
+        needs more bytes than have come, -1 if none fits."""
+        first, stop = self._trailing(layout) or (0, 0)
+        element = layout.elements[layout.command or 0]
+        sizes = sorted(
+            (layout.overhead + low, code)
+            for code, (low, high) in self.content_sizes.items()
+            if isinstance(code, int) and code >= 0 and low == high and (layout.codes is None or code in layout.codes)
+        )
+        for size, code in sizes:
+            if end - start < size:
+                return None
+            if int.from_bytes(buffer[start + size - first : start + size - stop], element.endian) == code:
+                return size
+        return -1
 
     def verifier(self, layout: Layout) -> Callable[[bytes, int, int], bool] | None:
         """Whether the checksum of the frame buffer[start:stop] of `layout` holds, without decoding it (no exception
@@ -810,7 +838,8 @@ class FrameCodec:
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         if plan["probe_inner"] is not None:  # sized by reading into the transformed span: probe() decides
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
-        if layout.codes is not None or layout.content < 0:  # layouts chosen by command, fixed frames: probe()
+        if layout.codes is not None or layout.content < 0 or self._trailing(layout) is not None:
+            # layouts chosen by command, fixed frames, a command element after the content: probe()
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
         need = max((stop for _, _, stop in head), default=0)

@@ -312,7 +312,7 @@ def error_reply_text(protocol: Protocol, message: Message) -> str:
 
 def shared_reply_text(protocol: Protocol, message: Message) -> str:
     """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
-    layout = protocol.framing.layouts[Direction.RESPONSE]
+    layout = protocol.layout(message)  # its own, where layouts are chosen by command
     code = protocol.command(message.command).wire_code(Direction.RESPONSE) if layout.has_command else None
     sharing, asking = reply_sharing(protocol)
     if protocol.framing.by_request(Direction.RESPONSE):
@@ -338,14 +338,14 @@ def reply_sharing(protocol: Protocol) -> tuple[Counter[int | None], dict[str, se
     answers."""
     cached = _SHARING.get(id(protocol))
     if cached is None or cached[0] is not protocol:
-        has_command = protocol.framing.layouts[Direction.RESPONSE].has_command
         sharing: Counter[int | None] = Counter()
         asking: dict[str, set[str]] = {}
         for m in protocol.messages():
             if m.direction == Direction.REQUEST:
                 asking.setdefault(m.answered_by or m.key, set()).add(m.command)
             elif not m.unsolicited and not protocol.command(m.command).subcommands:
-                sharing[protocol.command(m.command).wire_code(Direction.RESPONSE) if has_command else None] += 1
+                code = protocol.command(m.command).wire_code(Direction.RESPONSE)
+                sharing[code if protocol.layout(m).has_command else None] += 1
         _SHARING.clear()  # one protocol at a time: the cache never holds on to old models
         cached = _SHARING[id(protocol)] = (protocol, sharing, asking)
     return cached[1], cached[2]

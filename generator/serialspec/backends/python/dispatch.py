@@ -126,9 +126,12 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         if sub_dispatch:
             found.dispatchers.append(sub_dispatch | value_arguments(layout))
         message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
-        key = code_key(command, layout)
+        # its own layout, where layouts are chosen by command (`layout:`): frames of a layout without a command
+        # element carry no code
+        own = protocol.layout(next(m for m in command.messages() if m.direction == direction))
+        key = code_key(command, own)
         by_code.setdefault(key, []).append((message, target, low, high))
-        codes[key] = command.wire_code(direction) if layout.has_command else None
+        codes[key] = command.wire_code(direction) if own.has_command else None
     for key, users in by_code.items():
         # the resolver allows several only for plain replies, one of them marked default, and for requests told
         # apart by their content size

@@ -88,7 +88,8 @@ class FramingPass(FieldResolver):
                         (*path, "layouts"),
                         f"alternative layouts must all have a command element or none ({', '.join(with_command)} "
                         f"{'has' if len(with_command) == 1 else 'have'} one, {', '.join(without)} "
-                        f"{'has' if len(without) == 1 else 'have'} none)",
+                        f"{'has' if len(without) == 1 else 'have'} none), unless each command names its layout "
+                        "(`layout:`)",
                     )
         first = {d: layouts[0] for d, layouts in alternatives.items()}
         checksums = first[Direction.REQUEST].checksums or first[Direction.RESPONSE].checksums

@@ -11,9 +11,9 @@ from types import ModuleType
 
 import pytest
 from conftest import generate_and_import
-from serialspec.runtime.errors import DecodeError
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError
 from sim_process import serve
 
 ibus_module = pytest.importorskip("flySkyiBus.IBus")

@@ -41,3 +41,21 @@ def test_the_readme_stream_parser_snippet_runs_against_a_simulated_servo() -> No
     with serve("fashionstar_uart.yaml", 0) as port, contextlib.redirect_stdout(output):
         exec(compile(code.replace('"/dev/ttyUSB0"', repr(port)), "README.md", "exec"), {})
     assert output.getvalue().strip().lstrip("-").isdigit()
+
+
+def test_the_readme_names_the_errors_decode_and_encode_raise() -> None:
+    """Found by a new user (tests/test_newuser_ibus.py): the README showed decode and encode but not what they raise
+    on a bad frame or a bad message, nor where to import it from."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    imports = re.search(r"`(from serialspec\.runtime\.errors import [A-Za-z, ]+)`", text)
+    assert imports, "the README does not say where the errors come from"
+    names: dict[str, object] = {}
+    exec(imports.group(1), names)
+    from serialspec_protocols import fashionstar_uart as fs
+
+    frame = bytearray(fs.encode(fs.RotateRequest(servo_id=2, angle=900, interval=500)))
+    frame[-1] ^= 1
+    with pytest.raises(names["ChecksumError"]):  # type: ignore[call-overload]
+        fs.decode(bytes(frame))
+    with pytest.raises(names["RangeError"]):  # type: ignore[call-overload]
+        fs.encode(fs.RotateRequest(servo_id=2, angle=900, interval=500, power=-1))

@@ -537,6 +537,14 @@ CASES["frame: plain values, a sequence"] = Case(
         }
     },
 )
+# Alternative layouts holding different algorithms under one element name (MSP v1's XOR beside v2's CRC-8): each
+# layout's frames are checked with their own
+DVB_S2 = {"width": 8, "poly": 0xD5, "init": 0, "refin": False, "refout": False, "xorout": 0, "check": 0xBC}
+CASES["frame: layouts, each its own checksum algorithm"] = copy.deepcopy(CASES["frame: layouts"])
+_long = CASES["frame: layouts, each its own checksum algorithm"].framing
+assert _long is not None
+_long["layouts"]["long"]["elements"]["checksum"] |= {"algorithm": "crc", "crc": DVB_S2}
+
 # A content sent without its trailing zero bytes (MAVLink v2)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},

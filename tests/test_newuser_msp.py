@@ -128,16 +128,15 @@ def spec_with_v2(tmp_path: Path) -> Path:
     return spec
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding: alternative layouts with different checksum algorithms (v1 XOR, v2 CRC-8/DVB-S2) load, but a "
-    "v1 frame is then refused: 'bad checksum: the frame has 0x01, its bytes give 0xd5' (XOR of size..payload: 0x01)",
-)
 def test_v1_and_v2_layouts_each_keep_their_checksum(tmp_path: Path) -> None:
+    """Found by a new user: each layout's frames were checked with the last layout's algorithm (both elements are
+    named `checksum`), so a v1 frame was refused with 'bad checksum: ... give 0xd5'."""
     from serialspec.cli import main as serialspec_main
 
     spec = spec_with_v2(tmp_path)
-    assert serialspec_main(["decode", str(spec), "24 4d 3c 00 01 01"]) == 0
+    assert serialspec_main(["decode", str(spec), "24 4d 3c 00 01 01"]) == 0  # v1: XOR of size, command
+    assert serialspec_main(["decode", str(spec), "24 58 3c 00 01 00 00 00 45"]) == 0  # v2: CRC-8/DVB-S2
+    assert serialspec_main(["decode", str(spec), "24 58 3c 00 01 00 00 00 01"]) != 0  # v1's sum is no v2 checksum
 
 
 @pytest.mark.xfail(

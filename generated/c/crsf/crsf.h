@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "f662b26f1afd843ad3ef2ac3a0832beec36ec1b7097b9f1b91bff55a3c5b0fb4"
+#define CRSF_SPEC_SHA256 "8734ff3f648f4e0da5a2b88b5a399a07c0606d222699364b8f207c593ce42ff7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

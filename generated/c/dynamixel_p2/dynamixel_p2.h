@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "9def318305579c2114d8c7a417f243203da2282aea9ccffafe7e13e652fdcb07"
+#define DYNAMIXEL_P2_SPEC_SHA256 "5775e3726fe197bb3054a42668701774679d4ce2fff5d38526025a3e2652fd7d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "811a55d1d089a8b4c9655a057af7a63c1c27125dfa98ad751c2025548ac6f4a7"
+#define FEETECH_SMS_SPEC_SHA256 "36395821dfd8d579013d17d8a803d990b84bea838feb43cca4a3796169e69235"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

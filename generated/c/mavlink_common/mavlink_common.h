@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "88d90c6eed1a0f27cf9be737ac9bd8bcf6bfe22950b880a10aed2f07e315b2d8"
+#define MAVLINK_COMMON_SPEC_SHA256 "a1f03ec4e8353586de04dbe8d2f9e7719812221b0a9654e3fc169657272e9d4e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MODBUS_RTU_SPEC_SHA256 "3f7b616f39776e7fe4e96b2e5ae7887967d855607fc786f025d237101f0ed769"
+#define MODBUS_RTU_SPEC_SHA256 "ef991a4017fca0a6b92d036f2ecc7696659c7555e636d29335bf4bb0921797e7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MODBUS_RTU_ENABLE_ENCODE

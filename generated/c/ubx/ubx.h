@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "99ccc2add5901f89f7106f14510ebd0340e881137d590ab8a3eadfd3769c2be7"
+#define UBX_SPEC_SHA256 "250f84b50fac0ab3eb5e3349be02175f7830f6937aa7080a5c33cf782788f841"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

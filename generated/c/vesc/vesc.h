@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "2cec6a2431d18ca8c61f834f4c24b428339de2d42aeff2f79a5a9e8e6656ff6d"
+#define VESC_SPEC_SHA256 "bd337133bf629c8a8444d50757525235ce58fe1d1f0d4ecfd968bd00a147d695"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

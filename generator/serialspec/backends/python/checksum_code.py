@@ -12,7 +12,7 @@ Lines = list[str]
 
 def checksum_name(checksum: Checksum) -> str:
     """The codec's module-level name of a checksum's function (backends/python/frames/engine.py defines them)."""
-    return f"_CHECK_{checksum.name.upper()}"
+    return f"_CHECK_{(checksum.function or checksum.name).upper()}"
 
 
 def checksum_call(checksum: Checksum) -> str:

@@ -22,6 +22,10 @@ class Checksum:
     name: str = ""  # the frame element holding it
     skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
     from_request: tuple[str, ...] = ()  # a reply's: request elements whose bytes it takes in first (RoboClaw)
+    # The name its function goes by in generated code where it is not the element's: alternative layouts that hold
+    # different algorithms under one element name (MSP v1's XOR and v2's CRC-8, both `checksum`) get the layout's
+    # name after the element's.
+    function: str = ""
 
 
 VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries

@@ -91,6 +91,7 @@ class FramingPass(FieldResolver):
                         f"{'has' if len(without) == 1 else 'have'} none), unless each command names its layout "
                         "(`layout:`)",
                     )
+        alternatives = distinct_checksum_functions(alternatives)
         first = {d: layouts[0] for d, layouts in alternatives.items()}
         checksums = first[Direction.REQUEST].checksums or first[Direction.RESPONSE].checksums
         return Framing(
@@ -509,3 +510,34 @@ class FramingPass(FieldResolver):
             checksums=checksums,
             classic=classic,
         )
+
+
+def distinct_checksum_functions(alternatives: dict[Direction, list[FrameLayout]]) -> dict[Direction, list[FrameLayout]]:
+    """The layouts with each checksum's `function` named where alternative layouts hold different algorithms under
+    one element name: `<element>_<layout>`, so that each layout's frames are checked with their own algorithm."""
+    algorithms: dict[str, set[object]] = {}
+    for layouts in alternatives.values():
+        for layout in layouts:
+            for checksum in layout.checksums:
+                algorithms.setdefault(checksum.name, set()).add(checksum.algorithm)
+    shared = {name for name, found in algorithms.items() if len(found) > 1}
+    if not shared:
+        return alternatives
+
+    def named(layout: FrameLayout, checksum: Checksum) -> Checksum:
+        return replace(checksum, function=f"{checksum.name}_{layout.name}") if checksum.name in shared else checksum
+
+    return {
+        direction: [
+            replace(
+                layout,
+                elements=tuple(
+                    replace(e, checksum=named(layout, e.checksum)) if e.checksum is not None else e
+                    for e in layout.elements
+                ),
+                checksums=tuple(named(layout, c) for c in layout.checksums),
+            )
+            for layout in layouts
+        ]
+        for direction, layouts in alternatives.items()
+    }

@@ -11,11 +11,13 @@ from serialspec.backends.c.emit import (
     comment,
     content_max,
     decoder,
+    depth_of,
     encoder,
     error_element,
     frame_max,
     ident,
-    json_function,
+    json_bits,
+    json_fields,
     members,
     messages,
     msg_id,
@@ -1777,6 +1779,43 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap);
 
 #endif /* {P}_JSON_H */
 """
+
+
+def json_function(ctx: Ctx, message: Message) -> str:
+    mid = msg_id(message)
+    body: list[str] = []
+    first = True
+    layout = ctx.protocol.framing.layouts[message.direction]
+    for e in layout.value_elements:
+        sep = "" if first else ", "
+        first = False
+        body.append(f'    {ctx.p}__ws(w, "{sep}\\"{e.name}\\": ");')
+        if e.bits:
+            json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
+        else:
+            body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(e.name)});")
+    error = ctx.protocol.error_reply
+    if message.error_reply and error is not None:
+        body.append(f'    {ctx.p}__ws(w, "{"" if first else ", "}\\"{error.element}\\": ");')
+        body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(error.element)});")
+        first = False
+    first = json_fields(ctx, message.fields, "m->", body, 1, first)
+    if ctx.original is not None:  # optional frame elements, after every field (as the Python message's to_fields)
+        body += optional.json_lines(ctx, message.direction, first)
+    text = "\n".join(body)
+    locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
+    return "\n".join(
+        [
+            f"static void {ctx.p}__json_{mid}({ctx.p}__w_t *w, const {ctx.p}_{mid}_t *m)",
+            "{",
+            *locals_,
+            "    (void)w;",
+            "    (void)m;",
+            *body,
+            "}",
+            "",
+        ]
+    )
 
 
 def json_source(ctx: Ctx) -> str:

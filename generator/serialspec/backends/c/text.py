@@ -11,6 +11,7 @@ from typing import assert_never
 
 from serialspec.backends import Unsupported
 from serialspec.backends.c.emit import comment, ident, spec_hash
+from serialspec.backends.c.files import banner as binary_banner
 from serialspec.backends.c.files import role_macros
 from serialspec.backends.c.text_runtime import BEFORE_PARSER, CHECKED_READ, CHECKED_WRITE, HEAD, MIDDLE, PARSER
 from serialspec.checksums.base import NoCode
@@ -737,8 +738,6 @@ def _exact(value: float) -> tuple[int, int]:
 
 
 def banner(protocol: Protocol) -> str:
-    from serialspec.backends.c.files import banner as binary_banner
-
     return binary_banner(protocol)
 
 

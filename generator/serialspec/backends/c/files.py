@@ -675,7 +675,7 @@ def source(ctx: Ctx) -> str:
         for i, (_, c) in enumerate(ctx.checks)
     )
     reflect = ""
-    if any("__reflect(" in c.finish for _, c in ctx.checks):
+    if any(c.reflects for _, c in ctx.checks):
         reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
 {{
     uint32_t r = 0u;

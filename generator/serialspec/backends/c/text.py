@@ -432,9 +432,10 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
         end = ", ".join(_byte(c) for c in t.end)
         special_characters = sorted({t.start, t.separator, t.marker, *t.end})
         checked = t.checksum is not None
-        checksum = ""
+        checksum, reflects = "", False
         if t.checksum is not None:
             code = t.checksum.c_code(p)
+            reflects = code.reflects
             finish = code.finish.format(a="acc")
             checksum = f"""{code.definition}
 #if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE
@@ -447,7 +448,7 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 #endif
 """
         reflect = ""
-        if "__reflect(" in checksum:
+        if reflects:
             reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
 {{
     uint32_t r = 0u;

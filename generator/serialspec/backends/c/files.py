@@ -831,9 +831,6 @@ def source(ctx: Ctx) -> str:
     )
     kind_names = "\n".join(f'    case {kind_name(ctx, m)}: return "{msg_id(m)}";' for m in msgs)
     helpers = helper_functions(ctx)
-    span_decl = {
-        d: f"    uint8_t plain[{P}_MAX_FRAME];" if stuffed[d] else "    uint8_t *plain = NULL;" for d in stuffed
-    }
     n_layouts = {d: len(protocol.framing.alternatives[d]) for d in directions(protocol)}
     classic = 1 if protocol.framing.classic else 0
     headers = [layout.header for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
@@ -1095,7 +1092,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
-{span_decl_all(span_decl, P)}
+{span_decl_all(stuffed, P)}
     if (frame == NULL || out == NULL) {{
         return {P}_E_ARG;
     }}
@@ -1534,8 +1531,8 @@ def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
     )
 
 
-def span_decl_all(decls: dict[Direction, str], P: str) -> str:
-    if any("plain[" in d for d in decls.values()):
+def span_decl_all(stuffed: dict[Direction, bool], P: str) -> str:
+    if any(stuffed.values()):
         return f"    uint8_t plain[{P}_MAX_FRAME];"
     return "    uint8_t *plain = NULL;"
 

@@ -29,7 +29,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends import Unsupported
 from serialspec.backends.c import length_byte
-from serialspec.backends.c.emit import files as c_files
+from serialspec.backends.c.build import files as c_files
 from serialspec.lang.model import Direction, Message
 from serialspec.runtime.errors import DecodeError
 from strategies import message_fields

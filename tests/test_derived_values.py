@@ -26,7 +26,7 @@ from construct import ConstructError
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends import Unsupported
-from serialspec.backends.c.emit import files as c_files
+from serialspec.backends.c.build import files as c_files
 from serialspec.backends.python.memory import imported
 from serialspec.backends.python.package import emit_package
 from serialspec.checksums.crc import crc_function

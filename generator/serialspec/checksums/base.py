@@ -91,6 +91,7 @@ class CCode:
     start: str  # C expression of the accumulator's start value
     finish: str  # C expression of the checksum from the accumulator (a str.format template with {a}); it may call
     # `<prefix>__reflect(value, width)`, the low `width` bits of value in reverse order, which the C backend defines
+    reflects: bool = False  # finish calls <prefix>__reflect (the backend writes it only then)
 
 
 def c_finish(sign: str, whole: int) -> str:

@@ -440,7 +440,7 @@ class Crc(Algorithm):
 }}
 """
         prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-        return CCode(name, t, body, prototype, f"0x{start:x}u", finish)
+        return CCode(name, t, body, prototype, f"0x{start:x}u", finish, reflects=reflect)
 
     @classmethod
     def lua_function(cls) -> str:

@@ -103,7 +103,7 @@ class Seeded(Algorithm):
 }}
 """
         prototype = f"{core.prototype}\n{t} {name}({t} acc, const uint8_t *data, size_t n);"
-        return CCode(name, t, body, prototype, inner.start, inner.finish)
+        return CCode(name, t, body, prototype, inner.start, inner.finish, inner.reflects)
 
     @classmethod
     def lua_function(cls) -> str:

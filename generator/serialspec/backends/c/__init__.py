@@ -3,6 +3,6 @@
 from __future__ import annotations
 
 from serialspec.backends import Emitter
-from serialspec.backends.c.emit import files
+from serialspec.backends.c.build import files
 
 EMITTER = Emitter("c", files, folder="c")

@@ -195,12 +195,8 @@ class Ctx:
 
 
 def refuse_unsupported(protocol: Protocol) -> None:
-    """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
-    if protocol.text is not None:
-        from serialspec.backends.c.text import refuse
-
-        refuse(protocol.text)
-        return
+    """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
+    text.refuse)."""
     refuse_by_command(protocol)
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
@@ -1386,45 +1382,6 @@ def json_number(ctx: Ctx, t: ScalarType, expr: str) -> str:
     return f"{ctx.writer('wu')}(w, (uint32_t){expr});"
 
 
-def json_function(ctx: Ctx, message: Message) -> str:
-    mid = msg_id(message)
-    body: list[str] = []
-    first = True
-    layout = ctx.protocol.framing.layouts[message.direction]
-    for e in layout.value_elements:
-        sep = "" if first else ", "
-        first = False
-        body.append(f'    {ctx.p}__ws(w, "{sep}\\"{e.name}\\": ");')
-        if e.bits:
-            json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
-        else:
-            body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(e.name)});")
-    error = ctx.protocol.error_reply
-    if message.error_reply and error is not None:
-        body.append(f'    {ctx.p}__ws(w, "{"" if first else ", "}\\"{error.element}\\": ");')
-        body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(error.element)});")
-        first = False
-    first = json_fields(ctx, message.fields, "m->", body, 1, first)
-    if ctx.original is not None:  # optional frame elements, after every field (as the Python message's to_fields)
-        from serialspec.backends.c.optional import json_lines
-
-        body += json_lines(ctx, message.direction, first)
-    text = "\n".join(body)
-    locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
-    return "\n".join(
-        [
-            f"static void {ctx.p}__json_{mid}({ctx.p}__w_t *w, const {ctx.p}_{mid}_t *m)",
-            "{",
-            *locals_,
-            "    (void)w;",
-            "    (void)m;",
-            *body,
-            "}",
-            "",
-        ]
-    )
-
-
 # --- the whole files -------------------------------------------------------------------------------------------------
 
 
@@ -1434,38 +1391,3 @@ def spec_hash(protocol: Protocol) -> str:
     from dataclasses import replace
 
     return hashlib.sha256(repr(replace(protocol, spec_path="")).encode("utf-8")).hexdigest()
-
-
-def files(protocol: Protocol) -> dict[str, str]:
-    if protocol.text is not None:  # a text protocol: backends/c/text.py
-        from serialspec.backends.c import text
-
-        return text.files(protocol, protocol.text)
-    refuse_unsupported(protocol)
-    from serialspec.backends.c.optional import expanded
-
-    spec = protocol
-    protocol, variants = expanded(spec)  # optional elements: each layout's plain variants in its place
-    ctx = Ctx(protocol, protocol.name, protocol.name.upper(), original=spec if protocol is not spec else None)
-    ctx.variants = variants
-    for layouts in protocol.framing.alternatives.values():  # the checksums first: the header declares them
-        for layout in layouts:
-            for e in layout.elements:
-                if e.checksum is not None:
-                    ctx.check_index(e.checksum)
-    from serialspec.backends.c.files import header, json_header, json_source, source
-    from serialspec.backends.c.readme import readme
-    from serialspec.backends.c.vectors import check_vectors, vectors_header
-
-    p = protocol.name
-    h = header(ctx)
-    c = source(ctx)
-    return {
-        f"{p}/{p}.h": h,
-        f"{p}/{p}.c": c,
-        f"{p}/{p}_json.h": json_header(ctx),
-        f"{p}/{p}_json.c": json_source(ctx),
-        f"{p}/README.md": readme(ctx),
-        f"{p}/test/vectors.h": vectors_header(ctx),
-        f"{p}/test/check_vectors.c": check_vectors(ctx),
-    }

@@ -11,11 +11,13 @@ from serialspec.backends.c.emit import (
     comment,
     content_max,
     decoder,
+    depth_of,
     encoder,
     error_element,
     frame_max,
     ident,
-    json_function,
+    json_bits,
+    json_fields,
     members,
     messages,
     msg_id,
@@ -697,7 +699,7 @@ def source(ctx: Ctx) -> str:
         for i, (_, c) in enumerate(ctx.checks)
     )
     reflect = ""
-    if any("__reflect(" in c.finish for _, c in ctx.checks):
+    if any(c.reflects for _, c in ctx.checks):
         reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
 {{
     uint32_t r = 0u;
@@ -853,9 +855,6 @@ def source(ctx: Ctx) -> str:
     )
     kind_names = "\n".join(f'    case {kind_name(ctx, m)}: return "{msg_id(m)}";' for m in msgs)
     helpers = helper_functions(ctx)
-    span_decl = {
-        d: f"    uint8_t plain[{P}_MAX_FRAME];" if stuffed[d] else "    uint8_t *plain = NULL;" for d in stuffed
-    }
     n_layouts = {d: len(protocol.framing.alternatives[d]) for d in directions(protocol)}
     classic = 1 if protocol.framing.classic else 0
     headers = [layout.header for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
@@ -1117,7 +1116,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
-{span_decl_all(span_decl, P)}
+{span_decl_all(stuffed, P)}
     if (frame == NULL || out == NULL) {{
         return {P}_E_ARG;
     }}
@@ -1573,8 +1572,8 @@ def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
     )
 
 
-def span_decl_all(decls: dict[Direction, str], P: str) -> str:
-    if any("plain[" in d for d in decls.values()):
+def span_decl_all(stuffed: dict[Direction, bool], P: str) -> str:
+    if any(stuffed.values()):
         return f"    uint8_t plain[{P}_MAX_FRAME];"
     return "    uint8_t *plain = NULL;"
 
@@ -1818,6 +1817,43 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap);
 
 #endif /* {P}_JSON_H */
 """
+
+
+def json_function(ctx: Ctx, message: Message) -> str:
+    mid = msg_id(message)
+    body: list[str] = []
+    first = True
+    layout = ctx.protocol.framing.layouts[message.direction]
+    for e in layout.value_elements:
+        sep = "" if first else ", "
+        first = False
+        body.append(f'    {ctx.p}__ws(w, "{sep}\\"{e.name}\\": ");')
+        if e.bits:
+            json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
+        else:
+            body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(e.name)});")
+    error = ctx.protocol.error_reply
+    if message.error_reply and error is not None:
+        body.append(f'    {ctx.p}__ws(w, "{"" if first else ", "}\\"{error.element}\\": ");')
+        body.append(f"    {ctx.writer('wu')}(w, (uint32_t)m->{ident(error.element)});")
+        first = False
+    first = json_fields(ctx, message.fields, "m->", body, 1, first)
+    if ctx.original is not None:  # optional frame elements, after every field (as the Python message's to_fields)
+        body += optional.json_lines(ctx, message.direction, first)
+    text = "\n".join(body)
+    locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
+    return "\n".join(
+        [
+            f"static void {ctx.p}__json_{mid}({ctx.p}__w_t *w, const {ctx.p}_{mid}_t *m)",
+            "{",
+            *locals_,
+            "    (void)w;",
+            "    (void)m;",
+            *body,
+            "}",
+            "",
+        ]
+    )
 
 
 def json_source(ctx: Ctx) -> str:

@@ -5,15 +5,25 @@ message structs, the letters, the codes, each field's reader, writer and range c
 
 from __future__ import annotations
 
-import re
 from decimal import Decimal
 from typing import assert_never
 
 from serialspec.backends import Unsupported
 from serialspec.backends.c import parser_api
 from serialspec.backends.c.emit import comment, ident, spec_hash
+from serialspec.backends.c.files import banner as binary_banner
 from serialspec.backends.c.files import role_macros
-from serialspec.backends.c.text_runtime import BEFORE_PARSER, CHECKED_READ, CHECKED_WRITE, HEAD, MIDDLE, PARSER
+from serialspec.backends.c.text_runtime import (
+    BEFORE_PARSER,
+    CHECKED_READ,
+    CHECKED_WRITE,
+    HEAD,
+    MIDDLE,
+    PARSER,
+    Piece,
+    used,
+    written,
+)
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
@@ -57,6 +67,12 @@ class TextC:
         self.protocol, self.text = protocol, text
         self.p, self.P = protocol.name, protocol.name.upper()
         self.limit = text.max_length + len(text.end)
+        self.calls: set[str] = set()  # the runtime's helpers the code written calls (text_runtime.used)
+
+    def call(self, helper: str) -> str:
+        """The name of the runtime's helper pfx__<helper>, which the code written calls."""
+        self.calls.add(helper)
+        return f"{self.p}__{helper}"
 
     # --- the header ------------------------------------------------------------------------------------------------
 
@@ -259,30 +275,30 @@ const char *{p}_result_name(int result);
 
     def read(self, f: TextField, lv: str) -> str:
         """Decode statements of one field into the member `lv` (an lvalue path without the member name)."""
-        p, P, n = self.p, self.P, ident(f.name)
+        P, n = self.P, ident(f.name)
         target = f"{lv}{n}"
         match f.kind:
             case "decimal":
-                call = f"{p}__get_decimal(c->b + s, len, &{target})"
+                call = f"{self.call('get_decimal')}(c->b + s, len, &{target})"
             case "integer":
-                call = f"{p}__get_integer(c->b + s, len, &{target})"
+                call = f"{self.call('get_integer')}(c->b + s, len, &{target})"
             case "angle":
-                call = f"{p}__get_angle(c->b + s, len, {f.width or 2}u, &{target})"
+                call = f"{self.call('get_angle')}(c->b + s, len, {f.width or 2}u, &{target})"
             case "char":
-                call = f"{p}__get_char(c->b + s, len, &{target})"
+                call = f"{self.call('get_char')}(c->b + s, len, &{target})"
             case "text":
-                call = f"{p}__get_text(c->b + s, len, {target}, {P}_TEXT_MAX, &{target}_len)"
+                call = f"{self.call('get_text')}(c->b + s, len, {target}, {P}_TEXT_MAX, &{target}_len)"
             case "time":
-                call = f"{p}__get_time(c->b + s, len, &{target})"
+                call = f"{self.call('get_time')}(c->b + s, len, &{target})"
             case "date":
-                call = f"{p}__get_date(c->b + s, len, &{target})"
+                call = f"{self.call('get_date')}(c->b + s, len, &{target})"
             case _:
                 assert_never(f.kind)
         letters = ""
         if f.letters:
             allowed = " && ".join(f"{target} != '{_c_char(letter)}'" for _, letter in f.letters)
             letters = f"\n        if (r == {P}_OK && {allowed}) {{\n            r = {P}_E_CONTENT;\n        }}"
-        return f"""    {p}__next(c, &s, &len);
+        return f"""    {self.call("next")}(c, &s, &len);
     {lv}has_{n} = len > 0u;
     if (len > 0u) {{
         r = {call};{letters}
@@ -332,7 +348,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
 
     def check(self, f: TextField, lv: str) -> str:
         """The range checks of one field (encode refuses with P_E_RANGE before it writes)."""
-        p, P, n = self.p, self.P, ident(f.name)
+        P, n = self.P, ident(f.name)
         v = f"{lv}{n}"
         tests: list[str] = []
 
@@ -340,7 +356,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             for bound, sign in ((f.minimum, "<"), (f.maximum, ">")):
                 if bound is not None:
                     mantissa, exponent = _exact(bound)
-                    tests.append(f"{p}__compare({value}, {scale}, {mantissa}, {exponent}u) {sign} 0")
+                    tests.append(f"{self.call('compare')}({value}, {scale}, {mantissa}, {exponent}u) {sign} 0")
 
         match f.kind:
             case "decimal":
@@ -350,46 +366,46 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 bounds(v, "0u")
             case "angle":
                 tests.append(f"{v}.minutes.scale > 18u || {v}.minutes.value < 0")
-                tests.append(f"{p}__compare({v}.minutes.value, {v}.minutes.scale, 60, 0u) >= 0")
+                tests.append(f"{self.call('compare')}({v}.minutes.value, {v}.minutes.scale, 60, 0u) >= 0")
                 if f.minimum is not None:
-                    tests.append(f"{p}__angle_value(&{v}) < {float(f.minimum)!r}")
+                    tests.append(f"{self.call('angle_value')}(&{v}) < {float(f.minimum)!r}")
                 if f.maximum is not None:
-                    tests.append(f"{p}__angle_value(&{v}) > {float(f.maximum)!r}")
+                    tests.append(f"{self.call('angle_value')}(&{v}) > {float(f.maximum)!r}")
             case "char":
                 if f.letters:
                     tests.append(" && ".join(f"{v} != '{_c_char(letter)}'" for _, letter in f.letters))
-                tests.append(f"!{p}__carried({v})")
+                tests.append(f"!{self.call('carried')}({v})")
             case "text":
-                tests.append(f"{v}_len > {P}_TEXT_MAX || !{p}__text_ok({v}, {v}_len)")
+                tests.append(f"{v}_len > {P}_TEXT_MAX || !{self.call('text_ok')}({v}, {v}_len)")
             case "time":
-                tests.append(f"!{p}__time_ok(&{v})")
+                tests.append(f"!{self.call('time_ok')}(&{v})")
             case "date":
-                tests.append(f"!{p}__date_ok(&{v})")
+                tests.append(f"!{self.call('date_ok')}(&{v})")
             case _:
                 assert_never(f.kind)
         return "\n".join(f"    if ({lv}has_{n} && ({t})) {{\n        return {P}_E_RANGE;\n    }}" for t in tests)
 
     def write(self, f: TextField, lv: str) -> str:
-        p, n = self.p, ident(f.name)
+        n = ident(f.name)
         v = f"{lv}{n}"
         match f.kind:
             case "decimal":
-                call = f"{p}__put_decimal(o, &{v}, {v}.width)"
+                call = f"{self.call('put_decimal')}(o, &{v}, {v}.width)"
             case "integer":
-                call = f"{p}__put_integer(o, {v}, {f.width}u)"
+                call = f"{self.call('put_integer')}(o, {v}, {f.width}u)"
             case "angle":
-                call = f"{p}__put_angle(o, &{v}, {f.width or 2}u)"
+                call = f"{self.call('put_angle')}(o, &{v}, {f.width or 2}u)"
             case "char":
-                call = f"{p}__put(o, (uint8_t){v})"
+                call = f"{self.call('put')}(o, (uint8_t){v})"
             case "text":
-                call = f"{p}__put_text(o, {v}, {v}_len < {self.P}_TEXT_MAX ? {v}_len : {self.P}_TEXT_MAX)"
+                call = f"{self.call('put_text')}(o, {v}, {v}_len < {self.P}_TEXT_MAX ? {v}_len : {self.P}_TEXT_MAX)"
             case "time":
-                call = f"{p}__put_time(o, &{v})"
+                call = f"{self.call('put_time')}(o, &{v})"
             case "date":
-                call = f"{p}__put_date(o, &{v})"
+                call = f"{self.call('put_date')}(o, &{v})"
             case _:
                 assert_never(f.kind)
-        return f"    {p}__put(o, {self.P}__SEPARATOR);\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+        return f"    {self.call('put')}(o, {self.P}__SEPARATOR);\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
 
     def encoder(self, m: TextMessage) -> str:
         p, P = self.p, self.P
@@ -426,11 +442,12 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
         end = ", ".join(_byte(c) for c in t.end)
-        special = sorted({t.start, t.separator, t.marker, *t.end})
+        special_characters = sorted({t.start, t.separator, t.marker, *t.end})
         checked = t.checksum is not None
-        checksum = ""
+        checksum, reflects = "", False
         if t.checksum is not None:
             code = t.checksum.c_code(p)
+            reflects = code.reflects
             finish = code.finish.format(a="acc")
             checksum = f"""{code.definition}
 #if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE
@@ -443,7 +460,7 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 #endif
 """
         reflect = ""
-        if "__reflect(" in checksum:
+        if reflects:
             reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
 {{
     uint32_t r = 0u;
@@ -455,16 +472,6 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
     return r;
 }}
 """
-        parts = (HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER) if checked else (HEAD, MIDDLE, BEFORE_PARSER)
-        runtime = "".join(parts).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")  # the checksum's code: if any
-        parser = (
-            PARSER.replace("PFX_", f"{P}_")
-            .replace("pfx_", f"{p}_")
-            .replace(
-                "}\n#endif\n",
-                "}\n" + parser_api.frame_function(p) + parser_api.expect_function(p, P, True) + "#endif\n",
-            )
-        )
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}
@@ -488,7 +495,7 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             f"    case {P}_{mid(m).upper()}:\n"
             f"        if (check && !{P}_ENCODES_{m.direction.name}S) {{\n"
             f"            return {P}_E_ARG; /* left out */\n        }}\n"
-            f"        {p}__put_text(o, {c_text(m.code)}, {len(m.code)}u);\n"
+            f"        {self.call('put_text')}(o, {c_text(m.code)}, {len(m.code)}u);\n"
             f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
             for m in t.messages
         )
@@ -516,8 +523,31 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             if not t.talker
             else f"""    size_t i;
     for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{{{
-        {p}__put(o, (uint8_t)msg->talker[i]);
+        {self.call("put")}(o, (uint8_t)msg->talker[i]);
     }}}}"""
+        )
+        special = Piece(
+            f"""/* The framing's own characters: no field may hold one. */
+static int {p}__special(uint8_t c)
+{{
+    return {" || ".join(f"c == {_byte(c)}" for c in special_characters)};
+}}
+
+""",
+            "special",
+        )
+        parts = (
+            [*HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
+        )
+        helpers = used([special, *parts, PARSER], self.calls)
+
+        def prefixed(pieces: list[Piece]) -> str:
+            return written(pieces, helpers).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
+
+        runtime = prefixed(parts)
+        # the firmware API beside the parser (parser_api.py), inside the parser's feature switch
+        parser = prefixed([PARSER]).replace(
+            "}\n#endif\n", "}\n" + parser_api.frame_function(p) + parser_api.expect_function(p, P, True) + "#endif\n"
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
@@ -572,13 +602,7 @@ static int {p}__is(const uint8_t *b, size_t n, const char *s)
 }}
 #endif
 
-/* The framing's own characters: no field may hold one. */
-static int {p}__special(uint8_t c)
-{{
-    return {" || ".join(f"c == {_byte(c)}" for c in special)};
-}}
-
-{reflect}{checksum}{runtime}
+{written([special], helpers)}{reflect}{checksum}{runtime}
 #if {P}_ENABLE_DECODE
 {decoders}
 
@@ -737,7 +761,7 @@ const char *{p}_result_name(int result)
     return names[result];
 }}
 """
-        return drop_unused_static(text, p)
+        return text
 
 
 def _c_char(c: str) -> str:
@@ -756,33 +780,7 @@ def _exact(value: float) -> tuple[int, int]:
 
 
 def banner(protocol: Protocol) -> str:
-    from serialspec.backends.c.files import banner as binary_banner
-
     return binary_banner(protocol)
-
-
-def drop_unused_static(text: str, p: str) -> str:
-    """The runtime's static functions no code calls left out (-Wunused-function), until none is left to drop."""
-    while True:
-        dropped = False
-        for found in re.finditer(rf"^static [^\n;=]*?\b({p}__\w+)\(", text, re.MULTILINE):
-            name = found.group(1)
-            if len(re.findall(rf"\b{name}\(", text)) > 1:
-                continue
-            start = found.start()
-            while True:  # the comment before it
-                before = text.rfind("\n", 0, start - 1)
-                line = text[before + 1 : start - 1] if start > 0 else ""
-                if line.startswith(("/*", " *")) and start > 0:
-                    start = before + 1
-                    continue
-                break
-            stop = text.index("\n}\n", found.start()) + 3
-            text = text[:start] + text[stop:].lstrip("\n")
-            dropped = True
-            break
-        if not dropped:
-            return text
 
 
 def json_header(protocol: Protocol) -> str:

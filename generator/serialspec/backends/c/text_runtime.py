@@ -1,10 +1,57 @@
 """The C every text protocol's .c carries (`framing: {kind: text}`): the field readers and writers, the sentence
 cursor and the line parser, following serialspec.runtime.text (decode_field, encode_field, TextStreamParser).
-PFX_/pfx_ stand for the protocol's prefix; text.py writes what is the spec's (messages, codes, letters, ranges)."""
+PFX_/pfx_ stand for the protocol's prefix; text.py writes what is the spec's (messages, codes, letters, ranges).
 
-HEAD = r"""/* ---- the text runtime (runtime/text.py, as C) ---- */
+The runtime is a row of pieces: a static helper function is a piece of its own that says which helpers it calls, so
+text.py writes only the helpers its code calls (`used`), without reading the C it wrote."""
 
-static int64_t pfx__pow10(unsigned k)
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A stretch of the runtime's C. `name` "": always written; else it is the static function pfx__<name> (its
+    comment, its definition and the blank lines after it), written only where code written calls it. `needs`: the
+    helpers (pfx__<name>) the stretch calls."""
+
+    text: str
+    name: str = ""
+    needs: tuple[str, ...] = ()
+
+
+def used(pieces: Iterable[Piece], calls: Iterable[str]) -> set[str]:
+    """The helpers called: by the code written around the pieces (`calls`), by the pieces always written, and by
+    the helpers they call, to the end (-Wunused-function: no other is written)."""
+    pieces = list(pieces)
+    needs = {piece.name: piece.needs for piece in pieces if piece.name}
+    todo = [*calls, *(name for piece in pieces if not piece.name for name in piece.needs)]
+    found: set[str] = set()
+    while todo:
+        name = todo.pop()
+        if name not in found:
+            found.add(name)
+            todo.extend(needs.get(name, ()))
+    return found
+
+
+def written(pieces: Iterable[Piece], helpers: set[str]) -> str:
+    """The pieces' text, the helpers not in `helpers` left out."""
+    return "".join(piece.text for piece in pieces if not piece.name or piece.name in helpers)
+
+
+HEAD = (
+    Piece(
+        r"""/* ---- the text runtime (runtime/text.py, as C) ---- */
+
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""static int64_t pfx__pow10(unsigned k)
 {
     int64_t v = 1;
     while (k-- > 0u) {
@@ -13,12 +60,27 @@ static int64_t pfx__pow10(unsigned k)
     return v;
 }
 
-#if PFX_ENABLE_DECODE
-static int pfx__digit(uint8_t c)
+""",
+        "pow10",
+        (),
+    ),
+    Piece(
+        r"""#if PFX_ENABLE_DECODE
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""static int pfx__digit(uint8_t c)
 {
     return c >= 0x30u && c <= 0x39u;
 }
-#endif
+""",
+        "digit",
+        (),
+    ),
+    Piece(
+        r"""#endif
 
 /* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
 typedef struct {
@@ -29,7 +91,12 @@ typedef struct {
 } pfx__cursor_t;
 
 #if PFX_ENABLE_DECODE
-/* The next field (start and length), or an empty one past the last field the sentence has. */
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""/* The next field (start and length), or an empty one past the last field the sentence has. */
 static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
 {
     size_t i = c->pos;
@@ -47,7 +114,13 @@ static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
     c->pos = i < c->n ? i + 1u : i;
 }
 
-/* Digits d[0..n) as a number (at most 18 digits: PFX_E_CAPACITY beyond, a number an int64_t may not hold). */
+""",
+        "next",
+        (),
+    ),
+    Piece(
+        "/* Digits d[0..n) as a number (at most 18 digits: PFX_E_CAPACITY beyond, "
+        r"""a number an int64_t may not hold). */
 static int pfx__digits(const uint8_t *d, size_t n, int64_t *out)
 {
     int64_t v = 0;
@@ -62,7 +135,12 @@ static int pfx__digits(const uint8_t *d, size_t n, int64_t *out)
     return PFX_OK;
 }
 
-/* decimal: [+-]?(digits[.digits]|.digits), its digits kept (runtime/text.py Fixed). */
+""",
+        "digits",
+        (),
+    ),
+    Piece(
+        r"""/* decimal: [+-]?(digits[.digits]|.digits), its digits kept (runtime/text.py Fixed). */
 static int pfx__get_decimal(const uint8_t *t, size_t n, pfx_decimal_t *out)
 {
     size_t i = 0u, whole, point, fraction;
@@ -104,7 +182,12 @@ static int pfx__get_decimal(const uint8_t *t, size_t n, pfx_decimal_t *out)
     return r;
 }
 
-/* integer: [+-]?digits. */
+""",
+        "get_decimal",
+        ("digit", "digits"),
+    ),
+    Piece(
+        r"""/* integer: [+-]?digits. */
 static int pfx__get_integer(const uint8_t *t, size_t n, int64_t *out)
 {
     size_t i = 0u, first;
@@ -126,7 +209,12 @@ static int pfx__get_integer(const uint8_t *t, size_t n, int64_t *out)
     return r;
 }
 
-/* angle: 1..width digits of degrees, two of minutes, [.digits]; minutes below 60. */
+""",
+        "get_integer",
+        ("digit", "digits"),
+    ),
+    Piece(
+        r"""/* angle: 1..width digits of degrees, two of minutes, [.digits]; minutes below 60. */
 static int pfx__get_angle(const uint8_t *t, size_t n, unsigned width, pfx_angle_t *out)
 {
     size_t k = 0u;
@@ -150,7 +238,12 @@ static int pfx__get_angle(const uint8_t *t, size_t n, unsigned width, pfx_angle_
     return r;
 }
 
-/* time: hhmmss[.digits], a valid time of day; the fraction's first 6 digits kept as microseconds. */
+""",
+        "get_angle",
+        ("digit", "get_decimal", "pow10", "digits"),
+    ),
+    Piece(
+        r"""/* time: hhmmss[.digits], a valid time of day; the fraction's first 6 digits kept as microseconds. */
 static int pfx__get_time(const uint8_t *t, size_t n, pfx_time_t *out)
 {
     size_t i;
@@ -180,9 +273,19 @@ static int pfx__get_time(const uint8_t *t, size_t n, pfx_time_t *out)
     }
     return PFX_OK;
 }
-#endif
+""",
+        "get_time",
+        ("digit",),
+    ),
+    Piece(
+        r"""#endif
 
-/* The days of a month (Gregorian). */
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""/* The days of a month (Gregorian). */
 static unsigned pfx__days(unsigned month, unsigned year)
 {
     static const uint8_t days[12] = {31u, 28u, 31u, 30u, 31u, 30u, 31u, 31u, 30u, 31u, 30u, 31u};
@@ -190,8 +293,18 @@ static unsigned pfx__days(unsigned month, unsigned year)
     return month == 2u && leap ? 29u : days[month - 1u];
 }
 
-#if PFX_ENABLE_DECODE
-/* date: ddmmyy, a valid date; yy 69..99 is 1969..1999, 00..68 2000..2068 (as strptime's %y). */
+""",
+        "days",
+        (),
+    ),
+    Piece(
+        r"""#if PFX_ENABLE_DECODE
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""/* date: ddmmyy, a valid date; yy 69..99 is 1969..1999, 00..68 2000..2068 (as strptime's %y). */
 static int pfx__get_date(const uint8_t *t, size_t n, pfx_date_t *out)
 {
     size_t i;
@@ -214,7 +327,12 @@ static int pfx__get_date(const uint8_t *t, size_t n, pfx_date_t *out)
     return PFX_OK;
 }
 
-/* char: one character. */
+""",
+        "get_date",
+        ("digit", "days"),
+    ),
+    Piece(
+        r"""/* char: one character. */
 static int pfx__get_char(const uint8_t *t, size_t n, char *out)
 {
     if (n != 1u) {
@@ -224,7 +342,12 @@ static int pfx__get_char(const uint8_t *t, size_t n, char *out)
     return PFX_OK;
 }
 
-/* text: the characters as sent (PFX_E_CAPACITY past cap). */
+""",
+        "get_char",
+        (),
+    ),
+    Piece(
+        r"""/* text: the characters as sent (PFX_E_CAPACITY past cap). */
 static int pfx__get_text(const uint8_t *t, size_t n, char *out, size_t cap, uint16_t *len)
 {
     size_t i;
@@ -237,7 +360,12 @@ static int pfx__get_text(const uint8_t *t, size_t n, char *out, size_t cap, uint
     *len = (uint16_t)n;
     return PFX_OK;
 }
-#endif
+""",
+        "get_text",
+        (),
+    ),
+    Piece(
+        r"""#endif
 
 /* ---- writing: the text of each kind, as runtime/text.py encode_field writes it ---- */
 
@@ -248,7 +376,12 @@ typedef struct {
     int full; /* something did not fit */
 } pfx__out_t;
 
-static void pfx__put(pfx__out_t *o, uint8_t c)
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""static void pfx__put(pfx__out_t *o, uint8_t c)
 {
     if (o->n < o->cap) {
         o->b[o->n++] = c;
@@ -257,7 +390,12 @@ static void pfx__put(pfx__out_t *o, uint8_t c)
     }
 }
 
-/* v's decimal digits, at least `width` (zeros in front). */
+""",
+        "put",
+        (),
+    ),
+    Piece(
+        r"""/* v's decimal digits, at least `width` (zeros in front). */
 static void pfx__put_digits(pfx__out_t *o, uint64_t v, unsigned width)
 {
     uint8_t d[20];
@@ -275,12 +413,22 @@ static void pfx__put_digits(pfx__out_t *o, uint64_t v, unsigned width)
     }
 }
 
-static uint64_t pfx__magnitude(int64_t v)
+""",
+        "put_digits",
+        ("put",),
+    ),
+    Piece(
+        r"""static uint64_t pfx__magnitude(int64_t v)
 {
     return v < 0 ? (uint64_t)(-(v + 1)) + 1u : (uint64_t)v;
 }
 
-static void pfx__put_integer(pfx__out_t *o, int64_t v, unsigned width)
+""",
+        "magnitude",
+        (),
+    ),
+    Piece(
+        r"""static void pfx__put_integer(pfx__out_t *o, int64_t v, unsigned width)
 {
     if (v < 0) {
         pfx__put(o, 0x2Du);
@@ -288,7 +436,12 @@ static void pfx__put_integer(pfx__out_t *o, int64_t v, unsigned width)
     pfx__put_digits(o, pfx__magnitude(v), width);
 }
 
-static void pfx__put_decimal(pfx__out_t *o, const pfx_decimal_t *d, unsigned width)
+""",
+        "put_integer",
+        ("put", "put_digits", "magnitude"),
+    ),
+    Piece(
+        r"""static void pfx__put_decimal(pfx__out_t *o, const pfx_decimal_t *d, unsigned width)
 {
     uint64_t m = pfx__magnitude(d->value), scale = 1u;
     unsigned i;
@@ -305,13 +458,23 @@ static void pfx__put_decimal(pfx__out_t *o, const pfx_decimal_t *d, unsigned wid
     }
 }
 
-static void pfx__put_angle(pfx__out_t *o, const pfx_angle_t *a, unsigned width)
+""",
+        "put_decimal",
+        ("magnitude", "put", "put_digits"),
+    ),
+    Piece(
+        r"""static void pfx__put_angle(pfx__out_t *o, const pfx_angle_t *a, unsigned width)
 {
     pfx__put_digits(o, a->degrees, width);
     pfx__put_decimal(o, &a->minutes, 2u);
 }
 
-static void pfx__put_time(pfx__out_t *o, const pfx_time_t *t)
+""",
+        "put_angle",
+        ("put_digits", "put_decimal"),
+    ),
+    Piece(
+        r"""static void pfx__put_time(pfx__out_t *o, const pfx_time_t *t)
 {
     unsigned i;
     uint32_t scale = 100000u;
@@ -327,14 +490,24 @@ static void pfx__put_time(pfx__out_t *o, const pfx_time_t *t)
     }
 }
 
-static void pfx__put_date(pfx__out_t *o, const pfx_date_t *d)
+""",
+        "put_time",
+        ("put_digits", "put"),
+    ),
+    Piece(
+        r"""static void pfx__put_date(pfx__out_t *o, const pfx_date_t *d)
 {
     pfx__put_digits(o, d->day, 2u);
     pfx__put_digits(o, d->month, 2u);
     pfx__put_digits(o, d->year % 100u, 2u);
 }
 
-static void pfx__put_text(pfx__out_t *o, const char *t, size_t n)
+""",
+        "put_date",
+        ("put_digits",),
+    ),
+    Piece(
+        r"""static void pfx__put_text(pfx__out_t *o, const char *t, size_t n)
 {
     size_t i;
     for (i = 0u; i < n; i++) {
@@ -342,9 +515,20 @@ static void pfx__put_text(pfx__out_t *o, const char *t, size_t n)
     }
 }
 
-/* ---- range checks (encode refuses with PFX_E_RANGE before a byte is written) ---- */
+""",
+        "put_text",
+        ("put",),
+    ),
+    Piece(
+        r"""/* ---- range checks (encode refuses with PFX_E_RANGE before a byte is written) ---- */
 
-/* a / 10^as compared with b / 10^bs: -1, 0 or 1 (exact; a scaled value that overflows is the larger in size). */
+""",
+        "",
+        (),
+    ),
+    Piece(
+        "/* a / 10^as compared with b / 10^bs: -1, 0 or 1 (exact; "
+        r"""a scaled value that overflows is the larger in size). */
 static int pfx__compare(int64_t a, unsigned as, int64_t b, unsigned bs)
 {
     while (as < bs) {
@@ -364,24 +548,44 @@ static int pfx__compare(int64_t a, unsigned as, int64_t b, unsigned bs)
     return a < b ? -1 : a > b ? 1 : 0;
 }
 
-static int pfx__time_ok(const pfx_time_t *t)
+""",
+        "compare",
+        (),
+    ),
+    Piece(
+        r"""static int pfx__time_ok(const pfx_time_t *t)
 {
     return t->hour < 24u && t->minute < 60u && t->second < 60u && t->micro < 1000000u;
 }
 
-static int pfx__date_ok(const pfx_date_t *d)
+""",
+        "time_ok",
+        (),
+    ),
+    Piece(
+        r"""static int pfx__date_ok(const pfx_date_t *d)
 {
     return d->year >= 1u && d->year <= 9999u && d->month >= 1u && d->month <= 12u && d->day >= 1u &&
            d->day <= pfx__days(d->month, d->year);
 }
 
-/* A character a text frame can carry in a field: printable ASCII, none of the framing's own characters. */
+""",
+        "date_ok",
+        ("days",),
+    ),
+    Piece(
+        r"""/* A character a text frame can carry in a field: printable ASCII, none of the framing's own characters. */
 static int pfx__carried(char c)
 {
     return c >= 0x20 && c <= 0x7E && !pfx__special((uint8_t)c);
 }
 
-static int pfx__text_ok(const char *t, size_t n)
+""",
+        "carried",
+        ("special",),
+    ),
+    Piece(
+        r"""static int pfx__text_ok(const char *t, size_t n)
 {
     size_t i;
     for (i = 0u; i < n; i++) {
@@ -392,16 +596,31 @@ static int pfx__text_ok(const char *t, size_t n)
     return 1;
 }
 
-/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
+""",
+        "text_ok",
+        ("carried",),
+    ),
+    Piece(
+        r"""/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
 static double pfx__angle_value(const pfx_angle_t *a)
 {
     return (double)a->degrees + (double)a->minutes.value / (double)pfx__pow10(a->minutes.scale) / 60.0;
 }
 
-/* ---- the frame: start, address, fields, checksum after the marker, end ---- */
+""",
+        "angle_value",
+        ("pow10",),
+    ),
+    Piece(
+        r"""/* ---- the frame: start, address, fields, checksum after the marker, end ---- */
 
 #if PFX_ENABLE_DECODE
-static int pfx__hex_value(uint8_t c)
+""",
+        "",
+        (),
+    ),
+    Piece(
+        r"""static int pfx__hex_value(uint8_t c)
 {
     if (c >= 0x30u && c <= 0x39u) {
         return (int)c - 0x30;
@@ -415,7 +634,12 @@ static int pfx__hex_value(uint8_t c)
     return -1;
 }
 
-/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
+""",
+        "hex_value",
+        (),
+    ),
+    Piece(
+        r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
  * PFX_E_CHECKSUM. */
 static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
 {
@@ -432,10 +656,15 @@ static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
         return PFX_E_FRAME;
     }
     stop = end;
-"""
+""",
+        "",
+        ("unframe", "same"),
+    ),
+)
 
 # the checksum read and written where the protocol has one (text.py leaves them out otherwise)
-CHECKED_READ = r"""#if PFX__CHECKED
+CHECKED_READ = Piece(
+    r"""#if PFX__CHECKED
     {
         size_t at = end, k;
         uint32_t written = 0u;
@@ -462,9 +691,12 @@ CHECKED_READ = r"""#if PFX__CHECKED
         }
     }
 #endif
-"""
+""",
+    needs=("hex_value", "checksum"),
+)
 
-MIDDLE = r"""    *body = 1u;
+MIDDLE = Piece(
+    r"""    *body = 1u;
     *n = stop - 1u;
     return PFX_OK;
 }
@@ -501,9 +733,12 @@ static int pfx__frame(pfx__out_t *o, size_t *len)
 {
     size_t k;
     o->b[0] = PFX__START;
-"""
+""",
+    needs=("trim", "put", "frame"),
+)
 
-CHECKED_WRITE = r"""#if PFX__CHECKED
+CHECKED_WRITE = Piece(
+    r"""#if PFX__CHECKED
     {
         uint32_t sum = pfx__checksum(o->b + 1u, o->n - 1u);
         pfx__put(o, PFX__MARKER);
@@ -513,9 +748,12 @@ CHECKED_WRITE = r"""#if PFX__CHECKED
         }
     }
 #endif
-"""
+""",
+    needs=("checksum", "put"),
+)
 
-BEFORE_PARSER = r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
+BEFORE_PARSER = Piece(
+    r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
         pfx__put(o, pfx__end[k]);
     }
     if (o->full) {
@@ -526,10 +764,13 @@ BEFORE_PARSER = r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
 }
 #endif
 
-"""
+""",
+    needs=("put",),
+)
 
 # the line parser (text.py writes it after the messages' code)
-PARSER = r"""#if PFX_ENABLE_PARSER
+PARSER = Piece(
+    r"""#if PFX_ENABLE_PARSER
 /* Where `c` is in b[from..n), n if nowhere. */
 static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
 {
@@ -641,4 +882,6 @@ size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pf
     return len;
 }
 #endif
-"""
+""",
+    needs=("find", "find_end", "same", "drop", "push", "decode"),
+)

@@ -324,12 +324,13 @@ def simulator_module(protocol: Protocol) -> str:
         f"{s.access!r}),"
         for s in device.spaces
     ]
-    error = ""
+    error, unwraps = "", False
     if device.errors is not None and protocol.error_reply is not None:
         reply = protocol.command(protocol.error_reply.command).response
         assert reply is not None
         imports.add(reply.class_name)
-        unwrap = ", unwrap=_unwrap_request" if device.errors.unsupported else ""
+        unwraps = bool(device.errors.unsupported)
+        unwrap = ", unwrap=_unwrap_request" if unwraps else ""
         error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap})"
     runtime = ["CommandSpec", "DeviceSpec"]
     runtime += ["EntrySpec"] if entries else []
@@ -378,7 +379,7 @@ def simulator_module(protocol: Protocol) -> str:
         runtime_imports=", ".join(runtime),
         spaces=spaces,
         error=error,
-        unwrap="unwrap=_unwrap_request" in error,
+        unwrap=unwraps,
         timeout=timeout,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),

@@ -7,12 +7,24 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol as Interface
 
 from serialspec.backends.common.frames import layout_index, optional_elements
 from serialspec.backends.python.checksum_code import (
     checksum_expression,
     checksum_lines,
+)
+from serialspec.backends.python.frames.layouts import (
+    STRUCT_CHARS,
+    Lines,
+    Positions,
+    StraightLayouts,
+    Structs,
+    Target,
+    plus,
+    size_of,
+    stuffing_of,
+    variable_span,
 )
 from serialspec.backends.python.ir import (
     Block,
@@ -34,25 +46,37 @@ from serialspec.backends.python.kinds import (
 )
 from serialspec.backends.python.optimize import field_read
 from serialspec.lang.model import (
+    Direction,
     FrameLayout,
     Message,
+    Protocol,
 )
+from serialspec.lang.model import Field as SpecField
 from serialspec.runtime.framing import Element, Layout
 
-if TYPE_CHECKING:
-    from serialspec.backends.python.content import PackageCode
-from serialspec.backends.python.frames.layouts import (
-    STRUCT_CHARS,
-    Lines,
-    Positions,
-    StraightLayouts,
-    Structs,
-    Target,
-    plus,
-    size_of,
-    stuffing_of,
-    variable_span,
-)
+
+class PackageCode(Interface):
+    """What the frame around a message's content asks of the content's code (content.PackageCode, which calls
+    message_frame: this module does not import it)."""
+
+    protocol: Protocol
+    structs: dict[str, str]
+
+    def straight(self, direction: Direction) -> StraightLayouts | None: ...
+
+    def struct(self, base_name: str, fmt: str) -> str: ...
+
+    def encode_fields(self, fields: list[SpecField], base: str, obj: str, body: Block, where: str) -> list[str]: ...
+
+    def encode_run_format(
+        self, run: list[SpecField], obj: str, siblings: list[SpecField], body: Block, where: str
+    ) -> tuple[str, str, list[str]]: ...
+
+    def encode_run(
+        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], body: Block, where: str
+    ) -> str: ...
+
+    def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str: ...
 
 
 @dataclass

@@ -1,0 +1,42 @@
+"""A protocol's C files, from the modules that write them: the one module of the C target that imports the others
+(emit.py the shared parts, files.py the header, source and JSON, readme.py, vectors.py, text.py for a text protocol),
+none of which imports it."""
+
+from __future__ import annotations
+
+from serialspec.backends.c import text
+from serialspec.backends.c.emit import Ctx, refuse_unsupported
+from serialspec.backends.c.files import header, json_header, json_source, source
+from serialspec.backends.c.optional import expanded
+from serialspec.backends.c.readme import readme
+from serialspec.backends.c.vectors import check_vectors, vectors_header
+from serialspec.lang.model import Protocol
+
+
+def files(protocol: Protocol) -> dict[str, str]:
+    if protocol.text is not None:  # a text protocol: backends/c/text.py
+        return text.files(protocol, protocol.text)
+    refuse_unsupported(protocol)
+
+    spec = protocol
+    protocol, variants = expanded(spec)  # optional elements: each layout's plain variants in its place
+    ctx = Ctx(protocol, protocol.name, protocol.name.upper(), original=spec if protocol is not spec else None)
+    ctx.variants = variants
+    for layouts in protocol.framing.alternatives.values():  # the checksums first: the header declares them
+        for layout in layouts:
+            for e in layout.elements:
+                if e.checksum is not None:
+                    ctx.check_index(e.checksum)
+
+    p = protocol.name
+    h = header(ctx)
+    c = source(ctx)
+    return {
+        f"{p}/{p}.h": h,
+        f"{p}/{p}.c": c,
+        f"{p}/{p}_json.h": json_header(ctx),
+        f"{p}/{p}_json.c": json_source(ctx),
+        f"{p}/README.md": readme(ctx),
+        f"{p}/test/vectors.h": vectors_header(ctx),
+        f"{p}/test/check_vectors.c": check_vectors(ctx),
+    }

@@ -30,8 +30,9 @@ settings.load_profile("stress" if FUZZ_EXAMPLES else "ci")
 
 
 def examples(default: int) -> int:
-    """A fuzzer's max_examples: its short form in `make test`, SERIALSPEC_FUZZ_EXAMPLES in `make stress`."""
-    return FUZZ_EXAMPLES or default
+    """A fuzzer's max_examples: its short form in `make test`, SERIALSPEC_FUZZ_EXAMPLES in `make stress` (never
+    fewer than the short form: a long run does not run a test less than `make test` does)."""
+    return max(FUZZ_EXAMPLES, default) if FUZZ_EXAMPLES else default
 
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -105,7 +105,8 @@ def test_a_users_project_puts_its_packages_in_its_own_namespace(tmp_path: Path) 
     assert result.returncode == 0, result.stderr
     package = tmp_path / "generated" / "acme" / "devices" / "tinylamp"
     assert (package / "codec.py").is_file() and (package / "spec.yaml").is_file()
-    assert (tmp_path / "generated" / "docs" / "tinylamp.md").is_file()  # the references stay where they were
+    reference = (tmp_path / "generated" / "docs" / "tinylamp.md").read_text(encoding="utf-8")  # stays where it was
+    assert "Python package: `acme.devices.tinylamp`" in reference  # names the package where it went
     code = "import acme.devices.tinylamp as t; import tinylamp; assert tinylamp is t; print(t.PROTOCOL)"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "generator"), str(tmp_path / "generated")])}
     imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env)

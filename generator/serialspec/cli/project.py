@@ -183,7 +183,10 @@ def expected_files(
             }
         package = next(name for name in outputs.files if name.endswith(f"/{SHIPPED_SPEC}")).split("/")[0]
         if proj.namespace:
-            chosen = {_in_namespace(proj, package, name): text for name, text in chosen.items()}
+            chosen = {
+                _in_namespace(proj, package, name): _namespaced_docs(proj, package, name, text)
+                for name, text in chosen.items()
+            }
             if {"*", package} & proj.old_names and (not targets or "python" in targets):
                 chosen[f"{package}/__init__.py"] = _old_name(proj, spec, package)
         files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in chosen.items()})
@@ -284,6 +287,15 @@ def _in_namespace(proj: Project, package: str, name: str) -> str:
     """A package's file moved into the project's namespace; the other outputs (docs/, c/) stay where they are."""
     first, _, rest = name.partition("/")
     return f"{proj.package_folder(package)}/{rest}" if first == package else name
+
+
+def _namespaced_docs(proj: Project, package: str, name: str, text: str) -> str:
+    """A reference page names the package under the project's namespace, where the Python target's files went."""
+    if not (name.startswith("docs/") and name.endswith(".md")):
+        return text
+    from serialspec.backends.markdown.docs import python_package_words
+
+    return text.replace(python_package_words(package), python_package_words(f"{proj.namespace}.{package}"), 1)
 
 
 def _old_name(proj: Project, spec: Path, package: str) -> str:

@@ -63,6 +63,12 @@ def _link_end(match: re.Match[str]) -> str:
     return "\\]" if scheme and scheme[1].lower() not in SAFE_SCHEMES else "]"
 
 
+def python_package_words(import_name: str) -> str:
+    """How a reference page names the Python package to import; a project with a namespace moves the package, and
+    the page's words with it (cli/project.py)."""
+    return f"Python package: `{import_name}`"
+
+
 def text(value: str) -> str:
     """Spec text for a markdown paragraph: one line, HTML-significant characters escaped, attribute lists and links
     to other schemes than http, https and mailto (javascript:, data:, vbscript:, ...) shown as text."""
@@ -785,6 +791,7 @@ def emit_docs(protocol: Protocol) -> str:
         models=[model_context(device, m) for m in device.models] if device else [],
         model_entry=device.model_entry if device else "",
         protocol=protocol,
+        python_package=python_package_words(protocol.name),
         title=text(protocol.title),
         description=text(protocol.description),
         sources=[(k, text(v)) for k, v in protocol.sources.items()],

@@ -168,6 +168,24 @@ class Ctx:
     cap_defaults: dict[str, int] = field(default_factory=dict)  # capacity macro -> its default
     json_writers: set[str] = field(default_factory=set)  # the JSON writer functions called (wu, wi, wf, ...)
 
+    counters: set[int] = field(default_factory=set)  # the loop depths the function being written counts with
+
+    def counter(self, depth: int) -> str:
+        """The loop counter of nesting `depth` (i1, i2, ...), which the function being written then declares."""
+        self.counters.add(depth)
+        return f"i{depth}"
+
+    def loop(self, pad: str, depth: int, count: str) -> str:
+        """The head of a loop over `count` items with the counter of nesting `depth`."""
+        i = self.counter(depth)
+        return f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{"
+
+    def counter_locals(self) -> list[str]:
+        """The declarations of the counters the function's loops used (and a fresh start for the next function)."""
+        declared = [f"    size_t i{d};" for d in sorted(self.counters)]
+        self.counters.clear()
+        return declared
+
     def writer(self, name: str) -> str:
         """The JSON writer function `name` (p__wu, p__wbytes, ...), which its file then defines."""
         self.json_writers.add(name)
@@ -330,8 +348,16 @@ class Member:
     name: str
     decl: str
     doc: str
-    ctype: str = ""  # its C type (of one item, for an array), and how many: a number or a capacity macro (+ 1 for
-    count: int | str = 1  # a text's NUL); what readme.py sizes the structs from
+    ctype: str = ""  # its C type (of one item, for an array), and how many: a number or a capacity macro, and
+    count: int | str = 1  # how many items beyond that (a text's NUL); what readme.py sizes the structs from
+    extra: int = 0
+
+    @property
+    def dimension(self) -> str:
+        """How many items, as the declaration writes it ("" for one)."""
+        if self.count == 1 and not self.extra:
+            return ""
+        return f"[{self.count} + {self.extra}]" if self.extra else f"[{self.count}]"
 
 
 def cap_macro(ctx: Ctx, path: str, default: int) -> str:
@@ -382,7 +408,7 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                 size = f.size if isinstance(f.size, int) else min(room, DEFAULT_MAX_BYTES)
                 macro = cap_macro(ctx, f"{path}_{f.name}", size)
                 text_doc = doc + "; UTF-8, NUL-terminated here"
-                found.append(Member(name, f"char {name}[{macro} + 1u];", text_doc, "char", f"{macro} + 1"))
+                found.append(Member(name, f"char {name}[{macro} + 1u];", text_doc, "char", macro, 1))
                 found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes of text in {f.name}", "size_t"))
             case Group():
                 item = f"{ctx.p}_{path}_{f.name}_item_t"
@@ -530,7 +556,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Array():
                 total = f.count * f.item.size
                 out.append(f"{pad}if (n - o < {total}u) {{ return {ctx.P}_E_LENGTH; }}")
-                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(ctx.loop(pad, depth, f"{f.count}u"))
                 value = read_scalar(ctx, f.item, f.endian, f"c + o + i{depth} * {f.item.size}u")
                 out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                 out.append(f"{pad}}}")
@@ -589,19 +615,19 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     if not isinstance(f.count, int):
                         out.append(f"{pad}if ({count} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                         out.append(f"{pad}{tgt}_count = {count};")
-                    out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                    out.append(ctx.loop(pad, depth, count))
                     out.extend(body)
                     out.append(f"{pad}}}")
                 elif f.item_size is not None:
                     out.append(f"{pad}if ((n - o) % {f.item_size}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
                     out.append(f"{pad}if ((n - o) / {f.item_size}u > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                     out.append(f"{pad}{tgt}_count = (n - o) / {f.item_size}u;")
-                    out.append(f"{pad}for ({i} = 0u; {i} < {tgt}_count; {i}++) {{")
+                    out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                     out.extend(body)
                     out.append(f"{pad}}}")
                 else:
                     out.append(f"{pad}{tgt}_count = 0u;")
-                    out.append(f"{pad}for ({i} = 0u; o < n; {i}++) {{")
+                    out.append(f"{pad}for ({ctx.counter(depth)} = 0u; o < n; {i}++) {{")
                     out.append(f"{pad}    if ({i} >= {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                     out.extend(body)
                     out.append(f"{pad}    {tgt}_count = {i} + 1u;")
@@ -661,13 +687,13 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}{ctx.p}__copy({tgt}, c + o, len);")
                     ctx.helpers.add("copy")
                 else:
-                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                    out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                     value = read_scalar(ctx, f.item, f.endian, f"c + o + i{depth} * {item}u")
                     out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                     out.append(f"{pad}}}")
                 out.append(f"{pad}o += len;")
             case Packed():
-                out.extend(packed.decode(ctx.p, ctx.P, f, tgt, pad, f"i{depth}", ctx.helpers))
+                out.extend(packed.decode(ctx.p, ctx.P, f, tgt, pad, ctx.counter(depth), ctx.helpers))
             case _:
                 assert_never(f)
 
@@ -873,12 +899,9 @@ def uses_k(fields: tuple[Field, ...]) -> bool:
     )
 
 
-def depth_of(fields: tuple[Field, ...]) -> int:
-    return max((1 + depth_of(f.fields) for f in fields if isinstance(f, Group)), default=0)
-
-
 def decoder(ctx: Ctx, message: Message) -> str:
     mid = msg_id(message)
+    ctx.counters.clear()
     scope = Scope("m->", {})
     body: list[str] = []
     decode_fields(ctx, message.fields, scope, body, 1)
@@ -887,9 +910,7 @@ def decoder(ctx: Ctx, message: Message) -> str:
         locals_.append("    size_t len;")
     if uses_k(message.fields):
         locals_.append("    size_t k;")
-    for d in range(1, depth_of(message.fields) + 2):
-        if any(f"i{d}" in line for line in body):
-            locals_.append(f"    size_t i{d};")
+    locals_ += ctx.counter_locals()
     for f in message.fields:
         if isinstance(f, Scalar) and f.hidden and f.const is None:
             locals_.append(f"    {hidden_type(f)} d1_{ident(f.name)};")
@@ -980,7 +1001,7 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
             case Array():
                 test = range_test(f.minimum, f.maximum, f.item, f"{tgt}[i{depth}]")
                 if test:
-                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                    out.append(ctx.loop(pad, depth, f"{f.count}u"))
                     out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                     out.append(f"{pad}}}")
             case Bytes():
@@ -1004,7 +1025,7 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                 if not isinstance(f.count, int):
                     out.append(f"{pad}if ({count} > sizeof({tgt}) / sizeof({tgt}[0])) {{ return {ctx.P}_E_RANGE; }}")
                 if inner:
-                    out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                    out.append(ctx.loop(pad, depth, count))
                     out.extend(inner)
                     out.append(f"{pad}}}")
             case TableValue():
@@ -1032,13 +1053,13 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                 if f.item is not None:
                     test = range_test(f.minimum, f.maximum, f.item, f"{tgt}[i{depth}]")
                     if test:
-                        out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                        out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                         out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                         out.append(f"{pad}}}")
             case Packed():
                 test = range_test(f.minimum, f.maximum, packed.item_type(f), f"{tgt}[i{depth}]")
                 if test:
-                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                    out.append(ctx.loop(pad, depth, f"{f.count}u"))
                     out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                     out.append(f"{pad}}}")
             case _:
@@ -1107,7 +1128,7 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Array():
                 total = f.count * f.item.size
                 out.append(f"{pad}if (cap - o < {total}u) {{ return {ctx.P}_E_BUFFER; }}")
-                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(ctx.loop(pad, depth, f"{f.count}u"))
                 value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
                 out.append(f"{pad}    {put_call(ctx, f.item, f.endian, f'c + o + i{depth} * {f.item.size}u', value)}")
                 out.append(f"{pad}}}")
@@ -1140,7 +1161,7 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     if isinstance(h, Scalar) and h.derived:
                         derived_value(ctx, h, f.fields, item_scope, inner, pad + "    ", depth + 1)
                 encode_fields(ctx, f.fields, item_scope, inner, depth + 1)
-                out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                out.append(ctx.loop(pad, depth, count))
                 out.extend(inner)
                 out.append(f"{pad}}}")
             case TableValue():
@@ -1184,13 +1205,13 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     size = f.item.size
                     big = 1 if f.endian == ">" else 0
                     out.append(f"{pad}if ((cap - o) / {size}u < {tgt}_count) {{ return {ctx.P}_E_BUFFER; }}")
-                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                    out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                     value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
                     out.append(f"{pad}    {put_call(ctx, f.item, f.endian, 'c + o', value)} /* {f.name} */")
                     out.append(f"{pad}    o += {size}u;")
                     out.append(f"{pad}}}")
             case Packed():
-                out.extend(packed.encode(ctx.p, ctx.P, f, tgt, pad, f"i{depth}", ctx.helpers))
+                out.extend(packed.encode(ctx.p, ctx.P, f, tgt, pad, ctx.counter(depth), ctx.helpers))
             case _:
                 assert_never(f)
 
@@ -1216,6 +1237,7 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
 
 def encoder(ctx: Ctx, message: Message) -> str:
     mid = msg_id(message)
+    ctx.counters.clear()
     scope = Scope("m->", {})
     checks: list[str] = []
     check_fields(ctx, message.fields, scope, checks, 1)
@@ -1231,11 +1253,8 @@ def encoder(ctx: Ctx, message: Message) -> str:
     ctx.helpers.discard("j")
     body: list[str] = []
     encode_fields(ctx, message.fields, scope, body, 1)
-    text = "\n".join([*checks, *derived, *body])
     locals_ = ["    size_t o = 0u;"]
-    for d in range(1, depth_of(message.fields) + 2):
-        if f"i{d}" in text:
-            locals_.append(f"    size_t i{d};")
+    locals_ += ctx.counter_locals()
     if uses_j:
         locals_.append("    size_t j;")
     for f in message.fields:
@@ -1305,7 +1324,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(pad + json_number(ctx, value_type(f), tgt))
             case Array():
                 out.append(f'{pad}{ctx.p}__ws(w, "[");')
-                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(ctx.loop(pad, depth, f"{f.count}u"))
                 out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
                 out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
@@ -1319,7 +1338,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 i = f"i{depth}"
                 count = f"{f.count}u" if isinstance(f.count, int) else f"{tgt}_count"
                 out.append(f'{pad}{ctx.p}__ws(w, "[");')
-                out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                out.append(ctx.loop(pad, depth, count))
                 out.append(f'{pad}    {ctx.p}__ws(w, {i} ? ", {{" : "{{");')
                 json_fields(ctx, f.fields, f"{tgt}[{i}].", out, depth + 1, True)
                 out.append(f'{pad}    {ctx.p}__ws(w, "}}");')
@@ -1339,7 +1358,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f'{pad}{ctx.p}__ws(w, "}}");')
             case List():
                 out.append(f'{pad}{ctx.p}__ws(w, "[");')
-                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                 out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
                 if f.item is None:
                     bit = f"({tgt}[i{depth} / 8u] >> (i{depth} % 8u)) & 1u"
@@ -1350,7 +1369,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
             case Packed():
                 out.append(f'{pad}{ctx.p}__ws(w, "[");')
-                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(ctx.loop(pad, depth, f"{f.count}u"))
                 out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
                 out.append(f"{pad}    " + json_number(ctx, packed.item_type(f), f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")

@@ -11,7 +11,6 @@ from serialspec.backends.c.emit import (
     comment,
     content_max,
     decoder,
-    depth_of,
     encoder,
     error_element,
     frame_max,
@@ -1821,6 +1820,7 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap);
 
 def json_function(ctx: Ctx, message: Message) -> str:
     mid = msg_id(message)
+    ctx.counters.clear()
     body: list[str] = []
     first = True
     layout = ctx.protocol.framing.layouts[message.direction]
@@ -1840,8 +1840,7 @@ def json_function(ctx: Ctx, message: Message) -> str:
     first = json_fields(ctx, message.fields, "m->", body, 1, first)
     if ctx.original is not None:  # optional frame elements, after every field (as the Python message's to_fields)
         body += optional.json_lines(ctx, message.direction, first)
-    text = "\n".join(body)
-    locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
+    locals_ = ctx.counter_locals()
     return "\n".join(
         [
             f"static void {ctx.p}__json_{mid}({ctx.p}__w_t *w, const {ctx.p}_{mid}_t *m)",

@@ -33,12 +33,9 @@ def _round(n: int, align: int) -> int:
     return (n + align - 1) // align * align
 
 
-def _count(ctx: Ctx, count: int | str) -> int:
-    """An array's length: a number, a capacity macro at its default, or a macro + 1 (a text's NUL)."""
-    if isinstance(count, int):
-        return count
-    macro, _, plus = count.partition(" + ")
-    return ctx.cap_defaults[macro] + (int(plus) if plus else 0)
+def _count(ctx: Ctx, m: Member) -> int:
+    """An array's length: a number or a capacity macro at its default, and the items beyond it (a text's NUL)."""
+    return (m.count if isinstance(m.count, int) else ctx.cap_defaults[m.count]) + m.extra
 
 
 def _type(ctx: Ctx, ctype: str, size_t: int) -> tuple[int, int]:
@@ -55,7 +52,7 @@ def struct_size(ctx: Ctx, members: list[Member], size_t: int) -> tuple[int, int]
     offset, align = 0, 1
     for m in members or [Member("unused_", "", "", "uint8_t")]:
         size, a = _type(ctx, m.ctype, size_t)
-        offset = _round(offset, a) + size * _count(ctx, m.count)
+        offset = _round(offset, a) + size * _count(ctx, m)
         align = max(align, a)
     return _round(offset, align), align
 
@@ -186,12 +183,10 @@ def readme(ctx: Ctx) -> str:
             "| --- | --- | --- |",
         ]
         for member in found:
-            count = f"[{member.count}]" if member.count != 1 else ""
-            out.append(f"| `{member.name}` | `{member.ctype}{count}` | {_cell(member.doc)} |")
+            out.append(f"| `{member.name}` | `{member.ctype}{member.dimension}` | {_cell(member.doc)} |")
         items = [t for t in ctx.struct_members if t.startswith(f"{p}_{mid}_")]
         for item in items:
             out += ["", f"`{item}`:", "", "| member | C type | what it holds |", "| --- | --- | --- |"]
             for member in ctx.struct_members[item]:
-                count = f"[{member.count}]" if member.count != 1 else ""
-                out.append(f"| `{member.name}` | `{member.ctype}{count}` | {_cell(member.doc)} |")
+                out.append(f"| `{member.name}` | `{member.ctype}{member.dimension}` | {_cell(member.doc)} |")
     return "\n".join(out) + "\n"

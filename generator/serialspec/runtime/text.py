@@ -743,11 +743,12 @@ class TextCodec:
         # request code -> the codes of the responses that answer it and of those that refuse it, where these are
         # not its own command's response (the spec's `answered_by`: GRBL answers every line with ok or error:N)
         self.answers = dict(answers or {})
+        self._responses = {c: cls for (c, direction), cls in self.classes.items() if direction == "response"}
 
     def replies(self, code: str) -> tuple[tuple[type, ...], tuple[type, ...]]:
         """The response classes that answer a request of this code, and those that refuse it."""
         answering, refusing = self.answers.get(code, ((code,), ()))
-        responses = {c: cls for (c, direction), cls in self.classes.items() if direction == "response"}
+        responses = self._responses
         return tuple(responses[c] for c in answering if c in responses), tuple(responses[c] for c in refusing)
 
     def message(self, sentence: Sentence) -> Any:

@@ -574,6 +574,24 @@ class SizeRule:
 ERROR_REPLY = -1
 
 
+# A command element after a content of one size per code: its place from the frame's end (start, stop), its byte
+# order, and each (frame size, code), smallest first.
+_TrailingCodes = tuple[int, int, Literal["little", "big"], tuple[tuple[int, int], ...]]
+
+
+def _by_trailing_code(trailing: _TrailingCodes, buffer: bytes, start: int, end: int) -> int | None:
+    """Size of a frame whose command element follows a content of one size per code (TFmini's configuration
+    frames): the smallest frame with the code of its size in the command element; None while a candidate size
+    needs more bytes than have come, -1 if none fits."""
+    first, stop, endian, sizes = trailing
+    for size, code in sizes:
+        if end - start < size:
+            return None
+        if int.from_bytes(buffer[start + size - first : start + size - stop], endian) == code:
+            return size
+    return -1
+
+
 class FrameCodec:
     """One direction's frames: its layouts (alternatives, tried in order on encode), the content decoders' codes;
     `error_flag`: codes with these bits set are error replies (their sizes under ERROR_REPLY)."""
@@ -598,6 +616,7 @@ class FrameCodec:
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
+        self._trailing_cache: dict[int, _TrailingCodes | None] = {}  # by id() of a layout of self.variants
         # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
         self.sizers = tuple(self._sizer(layout) for layout in self.variants)
 
@@ -707,8 +726,10 @@ class FrameCodec:
                 return -1
         if layout.content < 0 and layout.transparency is None:
             return layout.overhead  # its fixed elements alone (a bare acknowledgement)
-        if code is None and self._trailing(layout) is not None:
-            return self._by_trailing_code(layout, buffer, start, end)
+        if code is None:
+            trailing = self._trailing_codes(layout)
+            if trailing is not None:
+                return _by_trailing_code(trailing, buffer, start, end)
         low, high = self.content_sizes.get(code, (0, None))
         if plan["probe_inner"] is not None:
             return _inner_size(layout, plan, buffer, start, end, low, high)
@@ -740,23 +761,26 @@ class FrameCodec:
             return None
         return next(((a, b) for index, a, b in plan["tail"] if index == layout.command), None)
 
-    def _by_trailing_code(self, layout: Layout, buffer: bytes, start: int, end: int) -> int | None:
-        """Size of a frame whose command element follows a content of one size per code (TFmini's configuration
-        frames): the smallest frame with the code of its size in the command element; None while a candidate size
-        needs more bytes than have come, -1 if none fits."""
-        first, stop = self._trailing(layout) or (0, 0)
-        element = layout.elements[layout.command or 0]
-        sizes = sorted(
-            (layout.overhead + low, code)
-            for code, (low, high) in self.content_sizes.items()
-            if isinstance(code, int) and code >= 0 and low == high and (layout.codes is None or code in layout.codes)
-        )
-        for size, code in sizes:
-            if end - start < size:
-                return None
-            if int.from_bytes(buffer[start + size - first : start + size - stop], element.endian) == code:
-                return size
-        return -1
+    def _trailing_codes(self, layout: Layout) -> _TrailingCodes | None:
+        """For a layout whose command element follows the content (see _trailing): where that element sits, and each
+        code's frame size, smallest first; worked out once per layout."""
+        key = id(layout)
+        if key not in self._trailing_cache:
+            place = self._trailing(layout)
+            if place is None:
+                self._trailing_cache[key] = None
+            else:
+                sizes = sorted(
+                    (layout.overhead + low, code)
+                    for code, (low, high) in self.content_sizes.items()
+                    if isinstance(code, int)
+                    and code >= 0
+                    and low == high
+                    and (layout.codes is None or code in layout.codes)
+                )
+                element = layout.elements[layout.command or 0]
+                self._trailing_cache[key] = (*place, element.endian, tuple(sizes))
+        return self._trailing_cache[key]
 
     def verifier(self, layout: Layout) -> Callable[[bytes, int, int], bool] | None:
         """Whether the checksum of the frame buffer[start:stop] of `layout` holds, without decoding it (no exception

@@ -53,6 +53,14 @@ FLAGS = [
     "-Wundef",
     "-Wstrict-prototypes",
     "-Wmissing-prototypes",
+    "-Wbad-function-cast",
+    "-Wdouble-promotion",
+    "-Wformat=2",
+    "-Wnull-dereference",
+    "-Wpointer-arith",
+    "-Wredundant-decls",
+    "-Wswitch-default",
+    "-Wvla",
 ]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-g"]
 GENERATED_C = ROOT / "generated" / "c"

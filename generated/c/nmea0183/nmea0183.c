@@ -447,7 +447,8 @@ static int nmea0183__carried(char c)
 /* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
 static double nmea0183__angle_value(const nmea0183_angle_t *a)
 {
-    return (double)a->degrees + (double)a->minutes.value / (double)nmea0183__pow10(a->minutes.scale) / 60.0;
+    const int64_t unit = nmea0183__pow10(a->minutes.scale); /* not cast in place: -Wbad-function-cast */
+    return (double)a->degrees + (double)a->minutes.value / (double)unit / 60.0;
 }
 
 /* ---- the frame: start, address, fields, checksum after the marker, end ---- */

@@ -604,7 +604,8 @@ static int pfx__carried(char c)
         r"""/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
 static double pfx__angle_value(const pfx_angle_t *a)
 {
-    return (double)a->degrees + (double)a->minutes.value / (double)pfx__pow10(a->minutes.scale) / 60.0;
+    const int64_t unit = pfx__pow10(a->minutes.scale); /* not cast in place: -Wbad-function-cast */
+    return (double)a->degrees + (double)a->minutes.value / (double)unit / 60.0;
 }
 
 """,

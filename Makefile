@@ -119,9 +119,10 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 bench: $(BENCH_STAMP) bench-tools
 	$(BIN)/python -m bench.run
 
-# The C target's two tables alone (flash and RAM on Cortex-M0+, parse throughput), replaced in bench/results.md.
+# The C target's tables alone (flash and RAM on Cortex-M0+, function groups, parse throughput, stack and vector
+# coverage), replaced in bench/results.md.
 bench-c: $(STAMP) bench-tools
-	$(BIN)/python -m bench.run c-size c-groups c-speed
+	$(BIN)/python -m bench.run c-size c-groups c-speed c-stack
 
 # The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
 docs: $(STAMP)

@@ -1,8 +1,9 @@
 """Run every benchmark family, print one markdown table per family, and write them all to bench/results.md.
 
 Usage: `make bench`, or `.venv/bin/python -m bench.run [family ...]` from the project root (families: codec,
-stream, latency, generation, startup, c-size, c-speed; default all). A full run rewrites bench/results.md; a run of
-some families (`make bench-c`: the C target's two) replaces their tables in it, each noting when and where it ran.
+stream, latency, generation, startup, c-size, c-groups, c-speed, c-stack; default all). A full run rewrites
+bench/results.md; a run of some families (`make bench-c`: the C target's) replaces their tables in it, each noting
+when and where it ran.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from bench import c_target, codec, generation, latency, startup, stream
+from bench import c_stack, c_target, codec, generation, latency, startup, stream
 from bench.timing import Table
 
 RESULTS = Path(__file__).resolve().parent / "results.md"
@@ -29,6 +30,7 @@ FAMILIES: dict[str, Callable[[], Table]] = {
     "c-size": c_target.sizes,
     "c-groups": c_target.groups,
     "c-speed": c_target.throughput,
+    "c-stack": c_stack.run,
 }
 
 

@@ -3,7 +3,12 @@ through a pointer as the deepest static function, a cycle refused (no bound)."""
 
 from __future__ import annotations
 
-from bench.c_stack import _graph, _worst
+import sys
+
+from conftest import ROOT
+
+sys.path.append(str(ROOT))  # bench/ is a folder of the project, not an installed package
+from bench.c_stack import _graph, _worst  # noqa: E402
 
 CALL_GRAPH = r"""graph: { title: "p.c"
 node: { title: "p.c:p_decode" label: "p_decode\np.c:10:5\n40 bytes (static)" }

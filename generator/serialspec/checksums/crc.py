@@ -9,9 +9,7 @@ from __future__ import annotations
 import struct
 from binascii import crc_hqx as crc_hqx  # re-exported: generated code calls it directly (Crc.python_call)
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from functools import cache
-from typing import Any
 
 from serialspec.checksums.base import (
     Algorithm,
@@ -27,6 +25,11 @@ from serialspec.checksums.base import (
     hex_bytes,
     hex_value,
 )
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def _reflect(value: int, width: int) -> int:

@@ -1,0 +1,154 @@
+"""`@dataclass(frozen=True)` for the runtime's value classes, without importing dataclasses.
+
+`dataclasses` imports inspect (and with it ast, dis, tokenize): about as much CPU time as a bare Python start, more
+than the rest of `serialspec decode PACKAGE HEX` (bench/startup.py, tests/test_cache.py). The frame engine's layouts
+(runtime/framing.py) and the checksum algorithms and frame transforms (serialspec/checksums/, transforms/), which
+generated packages import, are declared with this module's `dataclass`, `field` and `replace` instead. They behave
+as frozen dataclasses: keyword or positional construction with defaults, `field(default=..., default_factory=...,
+init=False)`, `__post_init__`, equality and hashing by field values (an instance equals only one of its own class),
+`Name(field=value, ...)` as repr, `__match_args__`, assignment raising dataclasses.FrozenInstanceError, pickling and
+copying; methods a class defines itself are kept. `replace` and `fields` work on them as dataclasses' do on
+dataclasses; `is_value` tells them apart. To a type checker they are dataclasses (the names are dataclasses' own).
+Not supported (nothing here uses it): anything but `frozen=True`, and other `field` options.
+"""
+
+from __future__ import annotations
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from dataclasses import dataclass, field, fields, replace
+    from typing import Any
+else:
+    _MISSING = object()
+
+    class _Field:
+        __slots__ = ("name", "default", "default_factory", "init")
+
+        def __init__(self, default: Any = _MISSING, default_factory: Any = _MISSING, init: bool = True) -> None:
+            self.name = ""
+            self.default, self.default_factory, self.init = default, default_factory, init
+
+        def __repr__(self) -> str:
+            return f"Field(name={self.name!r})"
+
+    def field(*, default: Any = _MISSING, default_factory: Any = _MISSING, init: bool = True) -> Any:
+        if default is not _MISSING and default_factory is not _MISSING:
+            raise ValueError("cannot specify both default and default_factory")
+        return _Field(default, default_factory, init)
+
+    def dataclass(cls: type | None = None, /, *, frozen: bool = False) -> Any:
+        if not frozen:
+            raise TypeError("serialspec.runtime.values makes frozen value classes only: @dataclass(frozen=True)")
+        return _make if cls is None else _make(cls)
+
+    def fields(value: Any) -> tuple[_Field, ...]:
+        found = getattr(value, "__value_fields__", None)
+        if found is None:
+            raise TypeError("fields() should be called on a value class or instance")
+        return tuple(found.values())
+
+    def replace(value: Any, /, **changes: Any) -> Any:
+        found = getattr(type(value), "__value_fields__", None)
+        if found is None:
+            raise TypeError("replace() should be called on value class instances")
+        for name in changes:
+            if name in found and not found[name].init:
+                raise ValueError(f"field {name} is declared with init=False, it cannot be specified with replace()")
+        given = {name: getattr(value, name) for name, f in found.items() if f.init and name not in changes}
+        return type(value)(**given, **changes)
+
+    def _frozen_setattr(self: object, name: str, value: object) -> None:
+        from dataclasses import FrozenInstanceError  # imported when raised
+
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def _frozen_delattr(self: object, name: str) -> None:
+        from dataclasses import FrozenInstanceError
+
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def _eq(self: Any, other: Any) -> Any:
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        names = self.__value_fields__
+        return tuple(getattr(self, n) for n in names) == tuple(getattr(other, n) for n in names)
+
+    def _hash(self: Any) -> int:
+        return hash(tuple(getattr(self, name) for name in self.__value_fields__))
+
+    def _repr(self: Any) -> str:
+        shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__value_fields__)
+        return f"{type(self).__qualname__}({shown})"
+
+    def _make(cls: type) -> type:
+        found: dict[str, _Field] = {}
+        for base in reversed(cls.__mro__[1:]):
+            found.update(getattr(base, "__value_fields__", {}))
+        own = cls.__dict__.get("__annotations__", {})
+        for name, annotation in own.items():
+            if isinstance(annotation, str) and annotation.replace("typing.", "").startswith("ClassVar"):
+                continue
+            value = cls.__dict__.get(name, _MISSING)
+            f = value if isinstance(value, _Field) else _Field(value)
+            f.name = name
+            found[name] = f
+            if f.default is _MISSING:
+                if name in cls.__dict__:
+                    delattr(cls, name)
+            else:
+                setattr(cls, name, f.default)
+        cls.__value_fields__ = found
+        _add(cls, "__init__", _init(cls, found))
+        _add(cls, "__repr__", _repr)
+        cls.__setattr__ = _frozen_setattr
+        cls.__delattr__ = _frozen_delattr
+        _add(cls, "__eq__", _eq)
+        if cls.__dict__.get("__hash__", None) is None:  # none of its own (defining __eq__ sets it to None)
+            cls.__hash__ = _hash
+        _add(cls, "__match_args__", tuple(name for name, f in found.items() if f.init))
+        return cls
+
+    def _add(cls: type, name: str, value: Any) -> None:
+        if name not in cls.__dict__:
+            setattr(cls, name, value)
+
+    def _init(cls: type, found: dict[str, _Field]) -> Any:
+        """An __init__ taking the fields as arguments, compiled once for the class (as dataclasses does)."""
+        names: dict[str, Any] = {"_MISSING": _MISSING}
+        arguments, body = [], []
+        for name, f in found.items():
+            if f.init:
+                if f.default_factory is not _MISSING:
+                    names[f"_factory_{name}"] = f.default_factory
+                    arguments.append(f"{name}=_MISSING")
+                    body.append(f"  d[{name!r}] = _factory_{name}() if {name} is _MISSING else {name}")
+                    continue
+                if f.default is not _MISSING:
+                    names[f"_default_{name}"] = f.default
+                    arguments.append(f"{name}=_default_{name}")
+                elif any(a.find("=") > 0 for a in arguments):
+                    raise TypeError(f"non-default argument {name!r} follows default argument")
+                else:
+                    arguments.append(name)
+                body.append(f"  d[{name!r}] = {name}")
+            elif f.default_factory is not _MISSING:
+                names[f"_factory_{name}"] = f.default_factory
+                body.append(f"  d[{name!r}] = _factory_{name}()")
+            elif f.default is not _MISSING:
+                names[f"_default_{name}"] = f.default
+                body.append(f"  d[{name!r}] = _default_{name}")
+        if hasattr(cls, "__post_init__"):
+            body.append("  self.__post_init__()")
+        source = f"def __init__(self, {', '.join(arguments)}):\n  d = self.__dict__\n" + "\n".join(body) + "\n"
+        exec(source, names)
+        init = names["__init__"]
+        init.__qualname__ = f"{cls.__qualname__}.__init__"
+        return init
+
+
+def is_value(value: object) -> bool:
+    """Whether `value` is an instance of a class made by this module's `dataclass`."""
+    return hasattr(type(value), "__value_fields__")
+
+
+__all__ = ["dataclass", "field", "fields", "is_value", "replace"]

@@ -2,39 +2,55 @@
 
 `dataclasses` imports inspect (and with it ast, dis, tokenize): about as much CPU time as a bare Python start, more
 than the rest of `serialspec decode PACKAGE HEX` (bench/startup.py, tests/test_cache.py). The frame engine's layouts
-(runtime/framing.py) and the checksum algorithms and frame transforms (serialspec/checksums/, transforms/), which
-generated packages import, are declared with this module's `dataclass`, `field` and `replace` instead. They behave
-as frozen dataclasses: keyword or positional construction with defaults, `field(default=..., default_factory=...,
-init=False)`, `__post_init__`, equality and hashing by field values (an instance equals only one of its own class),
+(runtime/framing.py), the text runtime (runtime/text.py) and generated text message classes, and the checksum
+algorithms and frame transforms (serialspec/checksums/, transforms/), which generated packages import, are declared
+with this module's `dataclass` and `field` instead. They behave as frozen dataclasses: keyword or positional
+construction with defaults, `field(default=..., default_factory=..., init=False, compare=False, repr=False)`,
+`__post_init__`, equality and hashing by the compared fields (an instance equals only one of its own class),
 `Name(field=value, ...)` as repr, `__match_args__`, assignment raising dataclasses.FrozenInstanceError, pickling and
-copying; methods a class defines itself are kept. `replace` and `fields` work on them as dataclasses' do on
-dataclasses; `is_value` tells them apart. To a type checker they are dataclasses (the names are dataclasses' own).
-Not supported (nothing here uses it): anything but `frozen=True`, and other `field` options.
+copying; methods a class defines itself are kept. `replace`, `fields` and `asdict` (of fields holding plain values)
+work on them as dataclasses' do on dataclasses; `is_value` tells them apart. To a type checker they are dataclasses
+(the names are dataclasses' own). Not supported (nothing here uses it): anything but `frozen=True`.
 """
 
 from __future__ import annotations
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
-    from dataclasses import dataclass, field, fields, replace
+    from dataclasses import asdict, dataclass, field, fields, replace
     from typing import Any
 else:
     _MISSING = object()
 
     class _Field:
-        __slots__ = ("name", "default", "default_factory", "init")
+        __slots__ = ("name", "default", "default_factory", "init", "compare", "repr")
 
-        def __init__(self, default: Any = _MISSING, default_factory: Any = _MISSING, init: bool = True) -> None:
+        def __init__(
+            self,
+            default: Any = _MISSING,
+            default_factory: Any = _MISSING,
+            init: bool = True,
+            compare: bool = True,
+            repr: bool = True,
+        ) -> None:
             self.name = ""
             self.default, self.default_factory, self.init = default, default_factory, init
+            self.compare, self.repr = compare, repr
 
         def __repr__(self) -> str:
             return f"Field(name={self.name!r})"
 
-    def field(*, default: Any = _MISSING, default_factory: Any = _MISSING, init: bool = True) -> Any:
+    def field(
+        *,
+        default: Any = _MISSING,
+        default_factory: Any = _MISSING,
+        init: bool = True,
+        compare: bool = True,
+        repr: bool = True,
+    ) -> Any:
         if default is not _MISSING and default_factory is not _MISSING:
             raise ValueError("cannot specify both default and default_factory")
-        return _Field(default, default_factory, init)
+        return _Field(default, default_factory, init, compare, repr)
 
     def dataclass(cls: type | None = None, /, *, frozen: bool = False) -> Any:
         if not frozen:
@@ -70,15 +86,19 @@ else:
     def _eq(self: Any, other: Any) -> Any:
         if other.__class__ is not self.__class__:
             return NotImplemented
-        names = self.__value_fields__
+        names = self.__value_compared__
         return tuple(getattr(self, n) for n in names) == tuple(getattr(other, n) for n in names)
 
     def _hash(self: Any) -> int:
-        return hash(tuple(getattr(self, name) for name in self.__value_fields__))
+        return hash(tuple(getattr(self, name) for name in self.__value_compared__))
 
     def _repr(self: Any) -> str:
-        shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__value_fields__)
+        shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__value_shown__)
         return f"{type(self).__qualname__}({shown})"
+
+    def asdict(value: Any) -> dict[str, Any]:
+        """The fields of a value class instance by name (as dataclasses.asdict gives for fields of plain values)."""
+        return {name: getattr(value, name) for name in value.__value_fields__}
 
     def _make(cls: type) -> type:
         found: dict[str, _Field] = {}
@@ -98,6 +118,8 @@ else:
             else:
                 setattr(cls, name, f.default)
         cls.__value_fields__ = found
+        cls.__value_compared__ = tuple(name for name, f in found.items() if f.compare)
+        cls.__value_shown__ = tuple(name for name, f in found.items() if f.repr)
         _add(cls, "__init__", _init(cls, found))
         _add(cls, "__repr__", _repr)
         cls.__setattr__ = _frozen_setattr
@@ -151,4 +173,4 @@ def is_value(value: object) -> bool:
     return hasattr(type(value), "__value_fields__")
 
 
-__all__ = ["dataclass", "field", "fields", "is_value", "replace"]
+__all__ = ["asdict", "dataclass", "field", "fields", "is_value", "replace"]

@@ -57,7 +57,13 @@ def _translate_once() -> None:
     it once. The translations are the same (the locale does not change while the command runs)."""
     if not hasattr(argparse._, "cache_info"):  # type: ignore[attr-defined]
         domain = gettext.textdomain()
-        catalogue = gettext.translation(domain, gettext.bindtextdomain(domain), fallback=True)
+        folder = gettext.bindtextdomain(domain)
+        if not os.path.isdir(folder):
+            # no catalogues at all (as in many Python installs): each text is its own translation, told without
+            # importing locale, as gettext's search of the folder would
+            argparse._ = functools.cache(str)  # type: ignore[attr-defined]
+            return
+        catalogue = gettext.translation(domain, folder, fallback=True)
         argparse._ = functools.cache(catalogue.gettext)  # type: ignore[attr-defined]
 
 

@@ -23,12 +23,15 @@ from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
 from serialspec.runtime.values import dataclass, field, replace
-from serialspec.transforms.base import SpanTransform
-from serialspec.transforms.replace import Transparency as Transparency  # generated code imports it from here
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
     from typing import Any, Literal
+
+    from serialspec.transforms.base import SpanTransform
+
+    # generated code imports it from here; at run time __getattr__ imports it (a codec without transparency does not)
+    from serialspec.transforms.replace import Transparency as Transparency
 
 # optional: bytes sent only when a bit of an earlier (flag) element is set; a Layout holding one hands each frame
 # to its variants (`Layout.variants`), plain layouts in which it is an `extra` (fixed bytes) or left out.

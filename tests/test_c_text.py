@@ -24,6 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.text import Sentence, TextField, TextFraming, TextSentence, encode_field
+from serialspec.runtime.values import replace
 from test_c_backend import BUILDS, C_CHECK, CLANG, FLAGS, GCC, GXX, Driver, compiler, m32_builds
 from test_language_matrix import TEXT_CASE
 from test_text_frames import sentence_values
@@ -84,7 +85,7 @@ def field_text(spec: TextField, value: Any) -> str:
         return str(value)
     if spec.kind == "char":
         return str(getattr(value, "value", value))
-    return encode_field("", dataclasses.replace(spec, minimum=None, maximum=None), value)
+    return encode_field("", replace(spec, minimum=None, maximum=None), value)
 
 
 def python_json(b: Built, sentence: Sentence) -> dict[str, Any]:

@@ -375,6 +375,44 @@ def test_decode_by_package_name_imports_neither_the_model_nor_dataclasses(tmp_pa
         ]
 
 
+def shipped_frames() -> dict[str, tuple[str, str]]:
+    """Each shipped protocol (specs/*.yaml) -> a frame of its first example as `decode` takes it (hex, or a text
+    protocol's sentence as typed) and its direction."""
+    frames = {}
+    for path in sorted((ROOT / "specs").glob("*.yaml")):
+        protocol = load_protocol(str(path))
+        if protocol.text is not None:
+            text = protocol.text.examples[0]
+            frames[protocol.name] = (text.printed, text.direction.value)
+        else:
+            example = protocol.examples[0]
+            frames[protocol.name] = ((example.printed_text or example.frame).hex(" "), example.direction.value)
+    return frames
+
+
+def test_decode_of_every_shipped_package_imports_neither_the_model_nor_dataclasses(tmp_path: Path) -> None:
+    """`decode PACKAGE HEX` of every shipped protocol (byte framings, COBS, escaping, optional elements, hex-ASCII,
+    text) answers from the generated package alone, as bench/startup.py times it: in one fresh process, after each
+    decode, none of the heavy modules (the model, the language, YAML, dataclasses, inspect, typing, pkgutil, pickle)
+    has been imported."""
+    frames = shipped_frames()
+    code = (
+        "import contextlib, io, sys\n"
+        "from serialspec.cli import main\n"
+        f"for name, (frame, direction) in {frames!r}.items():\n"
+        "    out = io.StringIO()\n"
+        "    with contextlib.redirect_stdout(out):\n"
+        "        code = main(['decode', name, frame, '--direction', direction])\n"
+        "    heavy = sorted(m for m in sys.modules if m in ('yaml', 'serialspec.lang.resolve', "
+        "'serialspec.lang.model', 'dataclasses', 'inspect', 'typing', 'pkgutil', 'pickle'))\n"
+        "    print(name, code, out.getvalue().split()[:2], heavy)\n"
+    )
+    env = {"SERIALSPEC_CACHE_DIR": str(tmp_path / "cache"), "PATH": ""}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
+    assert len(frames) >= 12
+    assert out.splitlines() == [f"{name} 0 [{name!r}, {direction!r}] []" for name, (_, direction) in frames.items()]
+
+
 def test_decode_with_units_takes_the_model_from_the_cache(tmp_path: Path) -> None:
     """What needs the spec (--units, --request, --file) reads its model, resolved once and then from the cache."""
     first = _decode_imports(tmp_path, "--units").splitlines()

@@ -7,10 +7,14 @@ SLIP-style escaping through engine objects, the way generated codecs describe th
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
+
 import pytest
 from conftest import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from serialspec.checksums import crc as crc_module
 from serialspec.checksums.crc import crc_function
 from serialspec.checksums.sum import sum_function
 from serialspec.checksums.xor import xor_function
@@ -58,9 +62,19 @@ def bitwise_crc(width: int, poly: int, init: int, refin: bool, refout: bool, xor
 def test_crc_of_any_length_matches_the_bitwise_model(
     name: str, params: tuple[int, int, int, bool, bool, int], check: int, data: bytes
 ) -> None:
-    """Short data, odd lengths, and data past the 16-bit CRCs' precompiled word runs (256 bytes and more)."""
+    """Short data, odd lengths, and data past the 16-bit CRCs' precompiled word runs (256 bytes and more); each CRC
+    fresh (a 16-bit one goes byte by byte at first) and after it has been fed enough to read two bytes per step."""
     assert bitwise_crc(*params, b"123456789") == check, name  # the reference itself
     assert crc_function(*params)(data) == bitwise_crc(*params, data), name
+    assert _fed(params)(data) == bitwise_crc(*params, data), name
+
+
+@functools.cache
+def _fed(params: tuple[int, int, int, bool, bool, int]) -> Callable[[bytes], int]:
+    """A CRC function that has been fed enough bytes to have switched to its word table (16-bit CRCs)."""
+    function = crc_function(*params)
+    function(bytes(crc_module._WORDS_AFTER))
+    return function
 
 
 def test_xor_and_sum_checksums() -> None:

@@ -12,7 +12,6 @@ import datetime
 import io
 import math
 import random
-from dataclasses import replace
 from decimal import Decimal
 from enum import Enum
 from typing import Any
@@ -34,6 +33,7 @@ from serialspec.runtime.text import (
     TextSentence,
     TextStreamParser,
 )
+from serialspec.runtime.values import replace
 from serialspec_protocols import nmea0183
 
 NMEA = nmea0183.FRAMING  # what specs/nmea0183.yaml declares

@@ -14,13 +14,11 @@ class per command and direction (decoded values keep the digits the device sent)
 from __future__ import annotations
 
 import datetime
-from dataclasses import dataclass, field
 from decimal import Decimal
 from enum import Enum
-from typing import ClassVar
 
 from serialspec.checksums.xor import xor_function
-from serialspec.runtime.message import Direction
+from serialspec.runtime.message import TYPE_CHECKING, Direction
 from serialspec.runtime.settings import SerialSettings
 from serialspec.runtime.text import (
     Angle,
@@ -34,6 +32,10 @@ from serialspec.runtime.text import (
     TextRepeat,
     TextSentence,
 )
+from serialspec.runtime.values import dataclass, field
+
+if TYPE_CHECKING:
+    from typing import ClassVar
 
 PROTOCOL = 'nmea0183'
 SPEC = 'specs/nmea0183.yaml'

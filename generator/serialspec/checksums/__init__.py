@@ -9,12 +9,15 @@ runtime wheel ships the package. Importing it finds nothing yet: a generated cod
 from __future__ import annotations
 
 import importlib
-import pkgutil
+import os
 from collections.abc import Mapping
 from functools import cache
-from typing import Any
 
 from serialspec.checksums.base import _REGISTERED, Algorithm, ChecksumProblem, Report
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["Algorithm", "ChecksumProblem", "algorithms", "from_spec", "owned_keys"]
 
@@ -22,8 +25,8 @@ __all__ = ["Algorithm", "ChecksumProblem", "algorithms", "from_spec", "owned_key
 @cache
 def algorithms() -> dict[str, type[Algorithm]]:
     """Every algorithm by its `algorithm:` name, in name order."""
-    for module in pkgutil.iter_modules(__path__):
-        importlib.import_module(f"{__name__}.{module.name}")
+    for module in _modules():
+        importlib.import_module(f"{__name__}.{module}")
     return dict(sorted(_REGISTERED.items()))
 
 
@@ -49,3 +52,14 @@ def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report)
         if key in raw and name not in owners:
             report((key,), f"`{key}` belongs to `algorithm: {' or '.join(owners)}`, not {name}")
     return found[name].from_spec(raw, size, type_name, report)
+
+
+def _modules() -> list[str]:
+    """The names of this package's modules (what pkgutil.iter_modules gives here, without importing pkgutil and
+    inspect: generated code that asks for one runtime name does not pay for them)."""
+    return sorted(
+        name[:-3]
+        for folder in __path__
+        for name in os.listdir(folder)
+        if name.endswith(".py") and name != "__init__.py"
+    )

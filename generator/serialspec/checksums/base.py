@@ -22,8 +22,12 @@ A new algorithm is one module of this package with one subclass that sets `name`
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+
+from serialspec.runtime.values import dataclass, field
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any, ClassVar, Literal
 
 Import = tuple[str, str]  # generated code's `from <module> import <name>` (the name may be `x as _y`)
 Report = Callable[[tuple[str, ...], str], None]  # a problem with the spec: keys below the element, message

@@ -9,9 +9,7 @@ from __future__ import annotations
 import struct
 from binascii import crc_hqx as crc_hqx  # re-exported: generated code calls it directly (Crc.python_call)
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from functools import cache
-from typing import Any
 
 from serialspec.checksums.base import (
     Algorithm,
@@ -27,6 +25,11 @@ from serialspec.checksums.base import (
     hex_bytes,
     hex_value,
 )
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def _reflect(value: int, width: int) -> int:
@@ -77,6 +80,12 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
         return lambda data: crc32(data, start) ^ mask ^ xorout
     if width == 16:
         return _crc16_words(poly, init, refin, refout, xorout)
+    return _crc_bytes(width, poly, init, refin, refout, xorout)
+
+
+def _crc_bytes(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
+    """The CRC as a loop over the bytes through the 256-entry table."""
+    mask = (1 << width) - 1
     table = crc_table(width, poly, refin)
     if refin:
         start = _reflect(init, width)
@@ -113,8 +122,12 @@ def crc_in_one_call(width: int, poly: int, init: int, refin: bool, refout: bool,
     return None
 
 
-# Runs of k 16-bit words (k < _WORD_RUNS) are read by precompiled structs, made at the first CRC's first call.
+# Runs of k 16-bit words (k < _WORD_RUNS) are read by precompiled structs, made with the word table.
 _WORD_RUNS = 128
+# A 16-bit CRC goes byte by byte until it has been fed this many bytes, then builds its word table: the table costs
+# about as much as the byte loop over this many bytes takes longer, so a command that checks one frame (`serialspec
+# decode`) does not pay milliseconds for it, and a stream pays at most about twice what the table saves.
+_WORDS_AFTER = 1 << 16
 
 
 @cache
@@ -137,10 +150,12 @@ def _word_table(poly: int, refin: bool) -> tuple[int, ...]:
 
 def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
     """A 16-bit CRC two bytes per step: the register after two more bytes is table[register ^ those two bytes]
-    (the bytes as one word, low byte first when reflected), from a 65,536-entry table made at the first call (a
-    few milliseconds, not paid by an import, shared by every CRC of that polynomial); an odd last byte goes through
-    the 256-entry table."""
+    (the bytes as one word, low byte first when reflected), from a 65,536-entry table made once it has been fed
+    _WORDS_AFTER bytes (a few milliseconds, not paid by an import, shared by every CRC of that polynomial; until
+    then it goes byte by byte); an odd last byte goes through the 256-entry table."""
     table = crc_table(16, poly, refin)
+    by_bytes = _crc_bytes(16, poly, init, refin, refout, xorout)
+    fed = 0
     order = "<" if refin else ">"
     unpack: tuple[Callable[[bytes], tuple[int, ...]], ...] = ()
     start = _reflect(init, 16) if refin else init
@@ -152,8 +167,11 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
         return (_reflect(value, 16) if refin != refout else value) ^ xorout
 
     def crc(data: bytes) -> int:
-        nonlocal pairs, unpack
+        nonlocal pairs, unpack, fed
         if not pairs:
+            fed += len(data)
+            if fed < _WORDS_AFTER:
+                return by_bytes(data)
             pairs, unpack = _word_table(poly, refin), _unpack_words(order)
         value = start
         n = len(data)

@@ -8,9 +8,7 @@ so a little-endian u16 element (the default) sends CK_A first, as UBX does; `end
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from itertools import accumulate
-from typing import Any
 
 from serialspec.checksums.base import (
     Algorithm,
@@ -23,6 +21,11 @@ from serialspec.checksums.base import (
     hex_bytes,
     hex_value,
 )
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def fletcher_function(modulus: int) -> Callable[[bytes], int]:

@@ -9,10 +9,13 @@ A code no command has gets no seed byte (the frame then fails as an unknown comm
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import Any, ClassVar, Literal
 
 from serialspec.checksums.base import Algorithm, CCode, Import, Report, hex_bytes, hex_value
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any, ClassVar, Literal
 
 
 def seeded_function(

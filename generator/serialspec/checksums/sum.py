@@ -4,8 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import Any
 
 from serialspec.checksums.base import (
     INVERT,
@@ -22,6 +20,11 @@ from serialspec.checksums.base import (
     finish_problem,
     hex_value,
 )
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def sum_function(width: int, invert: bool, negate: bool = False, mask: int | None = None) -> Callable[[bytes], int]:

@@ -4,8 +4,6 @@ optionally inverted, then optionally masked (HerkuleX: `& 0xFE`)."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import Any
 
 from serialspec.checksums.base import (
     INVERT,
@@ -21,6 +19,11 @@ from serialspec.checksums.base import (
     finish_problem,
     hex_value,
 )
+from serialspec.runtime.values import dataclass
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def xor_function(width: int, invert: bool = False, mask: int | None = None) -> Callable[[bytes], int]:

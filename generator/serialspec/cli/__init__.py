@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import gettext
 import importlib
 import os
 import sys
@@ -52,9 +53,27 @@ class _Formatter(argparse.HelpFormatter):
 def _translate_once() -> None:
     """argparse looks each of its texts ('usage: ', 'options', ...) up in gettext's catalogues every time it uses one,
     a search of the locale's folders each time (some 45 while the parser is built, a third of the command's start):
-    each text is looked up once. The translations are the same (the locale does not change while the command runs)."""
+    the catalogue of gettext's domain is looked up once (what gettext.gettext does for each text), and each text in
+    it once. The translations are the same (the locale does not change while the command runs)."""
     if not hasattr(argparse._, "cache_info"):  # type: ignore[attr-defined]
-        argparse._ = functools.cache(argparse._)  # type: ignore[attr-defined]
+        domain = gettext.textdomain()
+        folder = gettext.bindtextdomain(domain)
+        if not os.path.isdir(folder):
+            # no catalogues at all (as in many Python installs): each text is its own translation, told without
+            # importing locale, as gettext's search of the folder would
+            argparse._ = functools.cache(str)  # type: ignore[attr-defined]
+            return
+        catalogue = gettext.translation(domain, folder, fallback=True)
+        argparse._ = functools.cache(catalogue.gettext)  # type: ignore[attr-defined]
+
+
+class _Unbuilt:
+    """Stands for the parser of a verb that is not given (`serialspec --help`, or no verb, or an unknown one): the
+    command's help and errors name the verbs and their one-line help, and never parse with a verb's parser, so it
+    is not built (building all of them would cost a third of `serialspec --help`)."""
+
+    def __init__(self, **_: object) -> None:
+        pass
 
 
 def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
@@ -65,7 +84,9 @@ def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[s
     only = bool(chosen) and all(name in VERBS for name in chosen)
     parser = argparse.ArgumentParser(prog="serialspec", description=DESCRIPTION, formatter_class=_Formatter)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
-    verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
+    # argparse's parsers for the chosen verbs, where they are known; else none is parsed with (see _Unbuilt)
+    parser_class: type[argparse.ArgumentParser] = argparse.ArgumentParser if only else _Unbuilt  # type: ignore[assignment]
+    verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB", parser_class=parser_class)
     subparsers = {}
     for name, text in VERBS.items():
         if only and name not in chosen:

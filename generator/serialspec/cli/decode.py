@@ -47,7 +47,12 @@ def run(args: argparse.Namespace) -> int:
     if not args.hex and not args.file:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
     alone = None if args.file or args.request or args.units else package_alone(args.spec)
-    if alone is not None:  # the package answers alone: the spec's model is not loaded
+    if alone is not None and is_text(alone):  # the package answers alone: the spec's model is not loaded
+        from serialspec.cli import textframes
+
+        sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
+        return textframes.decode(alone.PROTOCOL, alone, sentences, args.json, args.direction)
+    if alone is not None:
         return decode_frames(
             args, lambda frame: alone.decode(frame, args.direction, None), lambda m, f: describe_alone(alone, m, f)
         )
@@ -63,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         if args.file:
             return replay(args, protocol, package)
         sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
-        return textframes.decode(protocol, package, sentences, args.json, args.direction)
+        return textframes.decode(protocol.name, package, sentences, args.json, args.direction)
     from serialspec.cli.views import message_spec
     from serialspec.lang.model import replies_by_request, reply_to
 
@@ -107,14 +112,21 @@ def decode_frames(
 
 
 def package_alone(spec: str) -> ModuleType | None:
-    """The generated package of a protocol given by name, when it answers `decode` alone: a binary protocol's package
-    that names the directions whose frames carry a checksum and its messages' register views (CHECKSUMMED,
-    REGISTER_VIEWS). Then neither the spec's model nor the spec language is imported. None for a spec file (or a
-    file of that name here), a text protocol's package or one generated before these names."""
+    """The generated package of a protocol given by name, when it answers `decode` alone: a text protocol's package,
+    or a binary protocol's package that names the directions whose frames carry a checksum and its messages'
+    register views (CHECKSUMMED, REGISTER_VIEWS). Then neither the spec's model nor the spec language is imported.
+    None for a spec file (or a file of that name here), or a binary package generated before these names."""
     if not spec.isidentifier() or os.path.isfile(spec):
         return None
     package, _, _ = installed_package(spec)
-    return package if hasattr(package, "CHECKSUMMED") and hasattr(package, "REGISTER_VIEWS") else None
+    if is_text(package) or (hasattr(package, "CHECKSUMMED") and hasattr(package, "REGISTER_VIEWS")):
+        return package
+    return None
+
+
+def is_text(package: ModuleType) -> bool:
+    """Whether a generated package is a text protocol's (its FRAMING a runtime.text.TextFraming)."""
+    return hasattr(package, "CODEC") and hasattr(getattr(package, "FRAMING", None), "sentences")
 
 
 def describe_alone(package: ModuleType, message: Message, frame: bytes) -> dict[str, Any]:
@@ -169,7 +181,7 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                         continue
                     message, request = seen.message, None
                     if text:
-                        result = textframes.describe(protocol, package, seen.data, message.DIRECTION.value)
+                        result = textframes.describe(protocol.name, package, seen.data, message.DIRECTION.value)
                     else:
                         if message.DIRECTION.value == "request":
                             asked = message

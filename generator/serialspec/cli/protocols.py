@@ -9,7 +9,6 @@ is used with the spec it ships.
 from __future__ import annotations
 
 import importlib
-import importlib.util
 import os
 import sys
 from types import ModuleType
@@ -108,9 +107,19 @@ def submodule(package: ModuleType, name: str) -> ModuleType | None:
     found = getattr(package, name, None)
     if found is not None or getattr(package, "__file__", None) is None:  # generated in memory: imported with it
         return found
-    if importlib.util.find_spec(f"{package.__name__}.{name}") is None:
-        return None
-    return importlib.import_module(f"{package.__name__}.{name}")
+    return _import_if_any(f"{package.__name__}.{name}")
+
+
+def _import_if_any(name: str, *, parent_missing: bool = False) -> ModuleType | None:
+    """The module `name` imported, or None where there is no such module (or, `parent_missing`, no such package
+    above it): what importlib.util.find_spec tells before an import, without importing importlib.util (and
+    contextlib with it) on the way of `serialspec decode PACKAGE`. An import error inside the module is raised."""
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as exc:
+        if exc.name == name or (parent_missing and exc.name and name.startswith(f"{exc.name}.")):
+            return None
+        raise
 
 
 def installed(name: str) -> tuple[Protocol, ModuleType]:
@@ -126,7 +135,10 @@ def installed_package(name: str) -> tuple[ModuleType, str, bytes]:
     here = os.getcwd()
     sys.path.insert(0, here)
     try:
-        package = importlib.import_module(_import_name(name))
+        local = not name.isidentifier() or os.path.isfile(os.path.join(name, "__init__.py"))
+        # as _import_name chooses: the folder's own package, else the shipped one, else NAME as it is
+        package = None if local else _import_if_any(f"{SHIPPED_NAMESPACE}.{name}", parent_missing=True)
+        package = package or importlib.import_module(name)
     except ImportError:
         raise SerialspecError(
             f"no such spec file, nor a protocol package {name}/ in this folder or installed: give the spec file "
@@ -157,6 +169,8 @@ def shipped_spec(name: str) -> Path | None:
         return None
     here = str(Path.cwd())
     sys.path.insert(0, here)
+    import importlib.util
+
     try:
         found = importlib.util.find_spec(_import_name(name))
     except (ImportError, ValueError):
@@ -174,6 +188,8 @@ def _import_name(name: str) -> str:
     else the shipped one under its namespace (not the old top-level alias, which warns), else NAME as it is."""
     if not name.isidentifier() or os.path.isfile(os.path.join(name, "__init__.py")):
         return name
+    import importlib.util
+
     try:
         shipped = importlib.util.find_spec(f"{SHIPPED_NAMESPACE}.{name}")
     except ImportError:
@@ -184,6 +200,7 @@ def _import_name(name: str) -> str:
 def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None:
     """The importable generated package of this protocol, if it was generated from exactly this spec text (the copy
     of the spec it ships says so); else None, and the caller builds the package from the spec instead."""
+    import importlib.util
     from pathlib import Path
 
     name = _import_name(protocol.name)

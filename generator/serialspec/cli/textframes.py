@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import sys
 from types import ModuleType
-from typing import Any
 
-from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import DecodeError, EncodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.text import DirectionNeeded, TextFraming, from_texts, texts
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def frame_of(framing: TextFraming, given: str) -> bytes:
@@ -29,13 +31,14 @@ def frame_of(framing: TextFraming, given: str) -> bytes:
         raise DecodeError(f"neither a sentence starting with {framing.start!r} nor hex: {exc}") from None
 
 
-def describe(protocol: Protocol, package: ModuleType, frame: bytes, direction: str | None = None) -> dict[str, Any]:
+def describe(protocol: str, package: ModuleType, frame: bytes, direction: str | None = None) -> dict[str, Any]:
+    """A frame of the text protocol named `protocol` as `decode --json` prints it (the package alone answers)."""
     framing: TextFraming = package.FRAMING
     sentence = framing.decode(frame, direction)
     cls = package.CODEC.classes[sentence.code, sentence.direction]
     body = frame.decode("ascii")
     return {
-        "protocol": protocol.name,
+        "protocol": protocol,
         "direction": cls.DIRECTION.value,
         "command": cls.COMMAND,
         "subcommand": None,
@@ -49,9 +52,7 @@ def describe(protocol: Protocol, package: ModuleType, frame: bytes, direction: s
     }
 
 
-def decode(
-    protocol: Protocol, package: ModuleType, frames: list[str], as_json: bool, direction: str | None = None
-) -> int:
+def decode(protocol: str, package: ModuleType, frames: list[str], as_json: bool, direction: str | None = None) -> int:
     failed = 0
     for given in frames:
         try:

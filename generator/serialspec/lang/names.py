@@ -13,7 +13,9 @@ from enum import Enum
 from typing import Any, TypeVar
 
 from serialspec.lang.model import Field, Group, Message, Protocol
+from serialspec.runtime import values
 from serialspec.runtime.message import spec_name as spec_name  # the inverse of python_name, for the runtime too
+from serialspec.runtime.values import is_value
 
 T = TypeVar("T")
 
@@ -76,15 +78,16 @@ def _rewrite(value: T, renames: dict[str, str], seen: dict[int, Any]) -> T:
         result = [_rewrite(item, renames, seen) for item in value]
     elif isinstance(value, dict):
         result = {_rewrite(k, renames, seen): _rewrite(v, renames, seen) for k, v in value.items()}
-    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+    elif (is_value(value) or dataclasses.is_dataclass(value)) and not isinstance(value, type):
+        kind: Any = values if is_value(value) else dataclasses  # the runtime's value classes, or dataclasses
         changes = {}
-        for f in dataclasses.fields(value):
+        for f in kind.fields(value):
             if f.name in _FREE_TEXT:
                 continue
             old = getattr(value, f.name)
             new = _rewrite(old, renames, seen)
             if new is not old:
                 changes[f.name] = new
-        result = dataclasses.replace(value, **changes) if changes else value
+        result = kind.replace(value, **changes) if changes else value
     seen[id(value)] = result
     return result  # type: ignore[no-any-return]

@@ -18,18 +18,27 @@ from __future__ import annotations
 import importlib
 import re
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field, replace
-from typing import Any, Literal
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
-from serialspec.transforms.base import SpanTransform
-from serialspec.transforms.replace import Transparency as Transparency  # generated code imports it from here
+from serialspec.runtime.values import dataclass, field, replace
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any, Literal
+
+    from serialspec.transforms.base import SpanTransform
+
+    # generated code imports it from here; at run time __getattr__ imports it (a codec without transparency does not)
+    from serialspec.transforms.replace import Transparency as Transparency
 
 # optional: bytes sent only when a bit of an earlier (flag) element is set; a Layout holding one hands each frame
 # to its variants (`Layout.variants`), plain layouts in which it is an `extra` (fixed bytes) or left out.
-ElementKind = Literal["constant", "value", "command", "length", "content", "checksum", "optional", "extra"]
+if TYPE_CHECKING:
+    ElementKind = Literal["constant", "value", "command", "length", "content", "checksum", "optional", "extra"]
+else:
+    ElementKind = str  # what it is at run time (typing's Literal is not imported)
 
 
 @dataclass(frozen=True)
@@ -576,7 +585,7 @@ ERROR_REPLY = -1
 
 # A command element after a content of one size per code: its place from the frame's end (start, stop), its byte
 # order, and each (frame size, code), smallest first.
-_TrailingCodes = tuple[int, int, Literal["little", "big"], tuple[tuple[int, int], ...]]
+_TrailingCodes = tuple[int, int, "Literal['little', 'big']", tuple[tuple[int, int], ...]]
 
 
 def _by_trailing_code(trailing: _TrailingCodes, buffer: bytes, start: int, end: int) -> int | None:
@@ -1148,6 +1157,8 @@ class EngineFormat:
 
 def __getattr__(name: str) -> Any:
     # each transform's runtime class (serialspec/transforms/), imported from here by generated code, loaded when asked
+    if name.startswith("__"):  # `from ... import` asks for __path__: not a transform (the registry imports pkgutil)
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     from serialspec.transforms import runtime_classes
 
     found = runtime_classes().get(name)

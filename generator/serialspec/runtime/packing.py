@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from typing import Any
 
 from serialspec.runtime.errors import DecodeError, EncodeError, shown
 from serialspec.runtime.message import is_sequence
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def unpack_runs(fmt: str, most: int) -> tuple[Callable[[bytes, int], tuple[Any, ...]], ...]:

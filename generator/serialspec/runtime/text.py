@@ -14,19 +14,23 @@ minutes), and a sentence remembers how many fields it had (trailing empty fields
 
 from __future__ import annotations
 
-import dataclasses
 import datetime
 import re
 from collections.abc import AsyncIterator, Callable, Generator, Iterable, Iterator, Mapping
-from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from enum import Enum
-from typing import Any, ClassVar, Literal
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, RangeError, shown
 from serialspec.runtime.message import Direction
+from serialspec.runtime.values import asdict, dataclass, field, fields
 
-TextKind = Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any, ClassVar, Literal
+
+    TextKind = Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+else:
+    TextKind = str  # what it is at run time (typing's Literal is not imported)
 
 
 class Clock(datetime.time):
@@ -521,7 +525,7 @@ def texts(sentence: TextSentence, values: Mapping[str, Any]) -> dict[str, Any]:
         if isinstance(item, TextField):
             found[item.name] = encode_field(sentence.where, item, value)
         else:
-            rows = [row if isinstance(row, Mapping) else dataclasses.asdict(row) for row in value or ()]
+            rows = [row if isinstance(row, Mapping) else asdict(row) for row in value or ()]
             found[item.name] = [
                 {f.name: encode_field(sentence.where, f, row.get(f.name)) for f in item.fields} for row in rows
             ]
@@ -683,8 +687,8 @@ def frames(framing: TextFraming, sentences: Iterable[Sentence]) -> bytes:
 
 
 class TextRecord:
-    """Base of the generated message classes of a text protocol (frozen dataclasses): `talker`, the fields in
-    order, and `sent` (how many fields the frame had; -1 writes every declared one)."""
+    """Base of the generated message classes of a text protocol (frozen value classes, serialspec.runtime.values):
+    `talker`, the fields in order, and `sent` (how many fields the frame had; -1 writes every declared one)."""
 
     COMMAND: ClassVar[str]
     CODE: ClassVar[str]
@@ -698,18 +702,18 @@ class TextRecord:
     def to_fields(self) -> dict[str, Any]:
         """The field values by name (groups as dicts), without talker and sent."""
         values = {}
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+        for f in fields(self):  # type: ignore[arg-type]
             if f.name in ("talker", "sent"):
                 continue
             value = getattr(self, f.name)
             if f.name in self.GROUPS:
-                value = [dataclasses.asdict(row) for row in value]
+                value = [asdict(row) for row in value]
             values[f.name] = value
         return values
 
     @classmethod
     def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> Any:
-        known = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+        known = {f.name for f in fields(cls)}  # type: ignore[arg-type]
         unknown = set(values) - known
         if unknown:
             raise EncodeError(f"{cls.CODE}: unknown field {sorted(unknown)[0]!r}")
@@ -722,7 +726,7 @@ class TextRecord:
                 given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
         if talker:
             given["talker"] = talker
-        factory: Any = cls  # a generated dataclass: its fields are keyword arguments
+        factory: Any = cls  # a generated value class: its fields are keyword arguments
         return factory(**given, sent=sent)
 
     def encode(self) -> bytes:

@@ -10,12 +10,15 @@ each transform's runtime class (through serialspec.runtime.framing), and the run
 from __future__ import annotations
 
 import importlib
-import pkgutil
+import os
 from collections.abc import Mapping
 from functools import cache
-from typing import Any
 
 from serialspec.transforms.base import _REGISTERED, DEFAULT, Report, Transform, TransformProblem
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["DEFAULT", "Transform", "TransformProblem", "from_spec", "owned_keys", "runtime_classes", "transforms"]
 
@@ -23,9 +26,9 @@ __all__ = ["DEFAULT", "Transform", "TransformProblem", "from_spec", "owned_keys"
 @cache
 def transforms() -> dict[str, type[Transform]]:
     """Every transform by its `method:` name, in name order."""
-    for module in pkgutil.iter_modules(__path__):
-        if module.name != "base":
-            importlib.import_module(f"{__name__}.{module.name}")
+    for module in _modules():
+        if module != "base":
+            importlib.import_module(f"{__name__}.{module}")
     return dict(sorted(_REGISTERED.items()))
 
 
@@ -50,3 +53,14 @@ def from_spec(raw: Mapping[str, Any], report: Report) -> Transform:
         if key in raw and owner != name:
             report((key,), f"`{key}` belongs to `method: {owner}`, not {name}")
     return found[name].from_spec(raw, report)
+
+
+def _modules() -> list[str]:
+    """The names of this package's modules (what pkgutil.iter_modules gives here, without importing pkgutil and
+    inspect: generated code that asks for one runtime name does not pay for them)."""
+    return sorted(
+        name[:-3]
+        for folder in __path__
+        for name in os.listdir(folder)
+        if name.endswith(".py") and name != "__init__.py"
+    )

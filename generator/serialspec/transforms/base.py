@@ -28,10 +28,15 @@ A new transform is one module of this package with one subclass that sets `name`
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal, Protocol
 
 from serialspec.checksums.base import ChecksumProblem
+from serialspec.runtime.values import dataclass, field
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any, ClassVar, Literal, Protocol
+else:
+    Protocol = object  # SpanTransform is a typing.Protocol to type checkers, at run time only a name
 
 __all__ = ["DEFAULT", "CTransform", "Key", "Report", "Sample", "SpanTransform", "Transform", "TransformProblem"]
 

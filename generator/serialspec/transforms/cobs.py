@@ -5,11 +5,14 @@ and the frame ends with a trailer 00, the delimiter (lang/passes/framing.py chec
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import Any
 
 from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.values import dataclass
 from serialspec.transforms.base import CTransform, Key, Report, Sample, Transform
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def cobs_encode(data: bytes, code_after_full_run: bool = True) -> bytes:

@@ -11,11 +11,14 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import Any
 
 from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.values import dataclass
 from serialspec.transforms.base import CTransform, Report, Sample, Transform
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 _DIGITS = b"0123456789ABCDEFabcdef"
 _HEX = frozenset(_DIGITS)

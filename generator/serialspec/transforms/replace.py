@@ -7,12 +7,15 @@ from __future__ import annotations
 import functools
 import re
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import Any
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.values import dataclass
 from serialspec.transforms.base import Key, Report, Sample, Transform, TransformProblem
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
+if TYPE_CHECKING:
+    from typing import Any
 
 
 @dataclass(frozen=True)

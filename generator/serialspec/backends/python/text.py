@@ -184,10 +184,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield "from __future__ import annotations"
     yield ""
     yield "import datetime"
-    yield "from dataclasses import dataclass, field"
     yield "from decimal import Decimal"
     yield "from enum import Enum"
-    yield "from typing import ClassVar"
     yield ""
     imports = []
     checksum = "None"
@@ -195,7 +193,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         (module, name), checksum = text.checksum.function_code()
         imports.append(f"from {module} import {name}")
     imports += [
-        "from serialspec.runtime.message import Direction",
+        "from serialspec.runtime.message import TYPE_CHECKING, Direction",
         "from serialspec.runtime.settings import SerialSettings",
         "from serialspec.runtime.text import (",
         "    Angle,",
@@ -209,6 +207,11 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         "    TextRepeat,",
         "    TextSentence,",
         ")",
+        # frozen dataclasses to users and type checkers, without importing dataclasses (and inspect) at run time
+        "from serialspec.runtime.values import dataclass, field",
+        "",
+        "if TYPE_CHECKING:",
+        "    from typing import ClassVar",
     ]
     yield from imports
     yield ""

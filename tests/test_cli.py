@@ -276,6 +276,18 @@ def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_not
     assert list(tmp_path.iterdir()) == []
 
 
+def test_check_of_a_spec_of_ones_own_names_the_generate_that_brings_it_up_to_date(tmp_path: Path) -> None:
+    """`check lamp.yaml --out .` sent the user to plain `serialspec generate`, which outside a project writes only a
+    schema into generated/ and leaves the check failing: the hint repeats the specs and --out it checked."""
+    shutil.copy(ROOT / "examples" / "tinylamp" / "tinylamp.yaml", tmp_path / "my lamp.yaml")
+    checked = serialspec("check", "my lamp.yaml", "--out", ".", cwd=tmp_path)
+    assert checked.returncode == 1
+    hint = checked.stderr.splitlines()[-1]
+    assert hint == "run `serialspec generate 'my lamp.yaml' --out .` to bring the generated files up to date"
+    assert serialspec("generate", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
+    assert serialspec("check", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
+
+
 def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path) -> None:
     """`generate --target c --out DIR` writes DIR/<protocol>/ (as the Python target writes DIR/<protocol>/), not the
     DIR/c/<protocol>/ the project's generated/ holds beside the Python packages."""

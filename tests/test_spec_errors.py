@@ -110,6 +110,18 @@ def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[s
     assert any(expected in line for line in lines), lines
 
 
+def test_a_misspelt_role_is_one_line_not_one_more_per_key_of_the_role(tmp_path: Path) -> None:
+    # `role: lenght` was said, then `counts` and `adds` were each said to belong to a length element
+    text = MINIMAL.replace(
+        "length: {role: length, type: u8}", "length: {role: lenght, type: u8, counts: [code, content], adds: 1}"
+    )
+    lines = errors_of(tmp_path, text)
+    assert len(lines) == 1 and "framing.elements.length.role: unknown value 'lenght'" in lines[0], lines
+    assert errors_of(tmp_path, MINIMAL.replace("role: content}", "role: content, adds: 1}")) == [
+        "tiny.yaml:10:36: framing.elements.content.adds: `adds` belongs to a length element"
+    ]
+
+
 def test_an_error_flag_with_a_command_code_that_is_not_a_number_is_an_error_line(tmp_path: Path) -> None:
     # the error-reply pass used to apply the flag to the code regardless (TypeError on a list, a traceback)
     text = MINIMAL.replace("type: u8}", "type: u8, error_flag: 0x80}").replace("code: 1", "code: [1]")

@@ -495,6 +495,10 @@ def test_docs_of_a_shipped_protocol_by_name_and_a_folder_it_cannot_write(tmp_pat
     assert (built.returncode, built.stderr) == (0, "")
     shipped = ROOT / "generated" / "serialspec_protocols" / "vesc" / "spec.yaml"
     assert (tmp_path / "site" / "specs" / "vesc.yaml").read_text() == shipped.read_text()
+    # the page's commands are the reader's to type: `scan vesc`, not the package's copy vesc/spec.yaml
+    page = (tmp_path / "site" / "protocols" / "vesc.html").read_text(encoding="utf-8")
+    assert "<code>serialspec scan vesc --port PORT</code>" in page and "spec.yaml" not in page
+    assert '<a href="../specs/vesc.yaml"><code>vesc</code></a>' in page
     (tmp_path / "a-file").write_text("")
     refused = serialspec("docs", "vesc", "--out", str(tmp_path / "a-file" / "site"))
     assert (refused.returncode, refused.stderr) == (

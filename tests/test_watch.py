@@ -27,7 +27,8 @@ WAIT = 120.0  # seconds a screen may take to show what is expected before the te
 
 
 class Pane:
-    """A tmux server of its own (tests run in parallel), one window of 160 x 40 running a command."""
+    """A tmux server of its own (tests run in parallel), one window of 160 x 40 (or `columns` wide) running a
+    command."""
 
     def __init__(self, name: str) -> None:
         self.socket = f"serialspec-test-{name}-{os.getpid()}"
@@ -39,10 +40,11 @@ class Pane:
         assert done.returncode == 0, done.stderr
         return done.stdout
 
-    def start(self, command: list[str]) -> None:
+    def start(self, command: list[str], columns: int = 160) -> None:
         shell = " ".join(_quote(word) for word in command)
         # the shell stays after the command ends, so its last screen (the final table) can be read
-        self.tmux("new-session", "-d", "-x", "160", "-y", "40", "-c", str(ROOT), f"{shell}; echo EXITED $?; sleep 60")
+        size = ["-x", str(columns), "-y", "40"]
+        self.tmux("new-session", "-d", *size, "-c", str(ROOT), f"{shell}; echo EXITED $?; sleep 60")
 
     def screen(self) -> str:
         return self.tmux("capture-pane", "-p")
@@ -125,5 +127,25 @@ def test_watch_listens_on_a_port_counting_rates_errors_and_bad_frames() -> None:
         assert row(text, " 1 ", "reply", "←", "overload"), text
         reply = row(text, " 1 ", "reply", "←").split("│")
         assert [cell.strip() for cell in reply[5:8]][0::2] == ["3", "1"], text  # 3 replies, 1 with an error bit
+        screen.tmux("send-keys", "C-c")
+        assert "EXITED 0" in screen.wait_for(lambda s: "EXITED" in s)
+
+
+def test_watch_in_an_80_column_terminal_keeps_each_value_on_its_row(tmp_path: Path) -> None:
+    """A terminal's default width: padded cells left the values 6 columns, so `2048 step (0.088°)` took three lines
+    and a session's rows ran off the screen."""
+    tap = tmp_path / "session.capture"
+    tap.write_text(
+        "# serialspec capture: feetech_sms\n"
+        "2026-11-28T10:04:17.699770+00:00 request ff ff 01 09 03 2a 00 08 f4 01 00 00 cb\n"
+        "2026-11-28T10:04:17.700000+00:00 response ff ff 01 02 00 fc\n",
+        encoding="utf-8",
+    )
+    with pane("narrow") as screen:
+        screen.start([sys.executable, "-m", "serialspec", "watch", SMS, "--tap", str(tap)], columns=80)
+        text = screen.wait_for(lambda s: "goal_time" in s)
+        assert row(text, " 1", "goal_position", "→", "2048 step (0.088°)"), text
+        assert row(text, " 1", "goal_time", "500 ms"), text
+        assert max(len(line) for line in text.splitlines()) <= 80
         screen.tmux("send-keys", "C-c")
         assert "EXITED 0" in screen.wait_for(lambda s: "EXITED" in s)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 from pathlib import Path
 
@@ -43,8 +44,18 @@ def run(args: argparse.Namespace) -> int:
     for problem in [*shown(errors), *problems]:
         print(problem, file=sys.stderr)
     if problems:  # a file to regenerate, not only mistakes in specs
-        print("run `serialspec generate` to bring the generated files up to date", file=sys.stderr)
+        print(f"run `{generate_command(args)}` to bring the generated files up to date", file=sys.stderr)
     if problems or errors:
         return 1
     print(f"{len(files)} generated {'file matches' if len(files) == 1 else 'files match'} the specs")
     return 0
+
+
+def generate_command(args: argparse.Namespace) -> str:
+    """The `serialspec generate` that writes what this check compared against: its specs, --out and --root."""
+    words = ["serialspec", "generate", *args.specs]
+    if args.out:
+        words += ["--out", args.out]
+    if args.root:
+        words += ["--root", str(args.root)]
+    return shlex.join(words)

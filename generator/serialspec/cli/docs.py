@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +30,8 @@ def run(args: argparse.Namespace) -> int:
     files: dict[str, Path] = {}
     for spec in args.specs:
         protocol, _ = open_spec(spec)
+        if not Path(spec).is_file():  # by name: the reference's commands (`serialspec scan vesc`) name it so too,
+            protocol = replace(protocol, spec_path=spec)  # not as the path of its package's copy (vesc/spec.yaml)
         if protocol.name in protocols:
             raise SerialspecError(f"{spec}: protocol {protocol.name} is given twice")
         protocols[protocol.name] = protocol

@@ -37,6 +37,7 @@ from serialspec.runtime.text import texts
 RATE_WINDOW = 5.0  # seconds over which a row's rate is counted
 REFRESH = 0.25  # seconds between redraws
 PIPE_WIDTH = 160  # columns of the table printed where the output is not a terminal
+NARROW = 100  # columns below which the table's cells have no padding
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -167,14 +168,18 @@ class Board:
             isinstance(f, Scalar) and f.status_ok is not None and fields.get(f.name) != f.status_ok for f in spec.fields
         )
 
-    def table(self, now: float) -> Any:
+    def table(self, now: float, width: int = PIPE_WIDTH) -> Any:
+        """The view at a console `width`. Below NARROW columns (an 80-column terminal) the cells lose their padding,
+        which leaves the values the room they need (padded, they had 6 columns there, and each row grew a line per
+        few characters of its values and pushed the table off the screen)."""
         from rich.table import Table
 
         title = (
             f"serialspec watch: {self.protocol.name} on {self.source} — {self.frames} frames, {self.bad} bad, "
             f"{self.garbage} bytes outside frames — Ctrl-C to quit"
         )
-        table = Table(title=title, title_justify="left", expand=True)
+        narrow = width < NARROW
+        table = Table(title=title, title_justify="left", expand=True, padding=(0, 0) if narrow else (0, 1))
         table.add_column("device", justify="right")
         table.add_column("command / register")
         table.add_column("dir")
@@ -295,20 +300,21 @@ def run(args: argparse.Namespace) -> int:
     end = time.monotonic() + args.duration if args.duration else None
     try:
         if console.is_terminal:
-            with Live(board.table(time.monotonic()), console=console, screen=True, auto_refresh=False) as live:
+            first = board.table(time.monotonic(), console.width)
+            with Live(first, console=console, screen=True, auto_refresh=False) as live:
                 drawn = 0.0
                 while not stopping and (end is None or time.monotonic() < end):
                     listen(source, board)
                     now = time.monotonic()
                     if now - drawn >= REFRESH:
-                        live.update(board.table(now), refresh=True)
+                        live.update(board.table(now, console.width), refresh=True)
                         drawn = now
         else:  # not a terminal (a pipe, a file): the table once, at the end
             while not stopping and (end is None or time.monotonic() < end):
                 listen(source, board)
         # on a terminal its width; elsewhere (a pipe, a file) a width that keeps rows on one line
         width = console.width if console.is_terminal else PIPE_WIDTH
-        Console(file=sys.stdout, width=width).print(board.table(time.monotonic()))
+        Console(file=sys.stdout, width=width).print(board.table(time.monotonic(), width))
     finally:
         source.close()
     return 0

@@ -14,6 +14,7 @@ from serialspec.checksums import ChecksumProblem
 from serialspec.checksums.seed import Seeded
 from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
+from serialspec.lang.grammar import FRAME_ELEMENT, Str
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -30,6 +31,9 @@ from serialspec.runtime.hexbytes import parse_hex
 from serialspec.transforms import TransformProblem
 
 CONSTANT_ROLES = ("header", "trailer", "constant")
+_ROLE = FRAME_ELEMENT.keys["role"]
+assert isinstance(_ROLE, Str)
+ROLES = _ROLE.choices  # the grammar's: a role outside them is reported there, once
 _CLASSIC_ROLES = {"header", "address", "command", "status", "value", "length", "content", "checksum"}
 
 
@@ -152,7 +156,7 @@ class FramingPass(FieldResolver):
             ("size", "optional"),
             ("present_if", "optional"),
         ):
-            if key in item and role != allowed:
+            if key in item and role != allowed and role in ROLES:  # an unknown role is one mistake, said once
                 article = "an" if allowed[0] in "aeiou" else "a"
                 self.error((*path, key), f"`{key}` belongs to {article} {allowed} element")
         return FrameElement(

@@ -48,7 +48,7 @@ def test_a_capture_is_drawn_as_png_and_svg_with_units_per_panel(session: Path, t
     )
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("serialspec plot: ") and result.stdout.endswith(
-        f"2 field(s) in {tmp_path / 'a.png'}\n"
+        f"2 fields in {tmp_path / 'a.png'}\n"
     )
     assert (tmp_path / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     result = serialspec("plot", str(session), "--field", "angle", "--id", "1", "--out", str(tmp_path / "a.svg"))
@@ -125,7 +125,7 @@ def test_live_from_a_port_for_a_duration(tmp_path: Path) -> None:
         os.close(controller)
         os.close(device)
     assert process.returncode == 0, err
-    assert out == f"serialspec plot: 2 values of 1 field(s) in {tmp_path / 'live.svg'}\n"
+    assert out == f"serialspec plot: 2 values of 1 field in {tmp_path / 'live.svg'}\n"
     assert "<!-- read_angle response, servo_id 3 -->" in (tmp_path / "live.svg").read_text(encoding="utf-8")
 
 

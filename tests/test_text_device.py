@@ -215,7 +215,7 @@ def test_plot_draws_a_text_capture_s_numbers_in_their_units(tmp_path: Path) -> N
         [*CLI, "plot", str(capture), "--spec", SPEC, *fields, "--out", str(out)], capture_output=True, text=True
     )
     assert done.returncode == 0, done.stderr
-    assert "8 values of 3 field(s)" in done.stdout  # latitude from 2 GGA + 2 RMC, altitude 2, speed 2
+    assert "8 values of 3 fields" in done.stdout  # latitude from 2 GGA + 2 RMC, altitude 2, speed 2
     svg = out.read_text(encoding="utf-8")
     assert "altitude (m)" in svg and "speed (kn)" in svg and "latitude (°)" in svg
     refused = subprocess.run(

@@ -85,7 +85,9 @@ def run(args: argparse.Namespace) -> int:
     panels = collect(protocol, package, chunks, args.fields, set(args.ids or ()))
     draw(pyplot, panels, f"{protocol.name}: {source}", out)
     count = sum(len(s.values) for p in panels for s in p.lines.values())
-    print(f"serialspec plot: {count} values of {len(panels)} field(s) in {out}")
+    values = f"{count} value{'s' * (count != 1)}"
+    fields = f"{len(panels)} field{'s' * (len(panels) != 1)}"
+    print(f"serialspec plot: {values} of {fields} in {out}")
     return 0
 
 

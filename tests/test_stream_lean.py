@@ -129,10 +129,15 @@ def test_fashion_star_replies_take_the_sieve() -> None:
 
 
 @pytest.mark.parametrize(("g", "direction"), SIEVED, ids=[f"{g.protocol.name}:{d.value}" for g, d in SIEVED])
-def test_reads_of_one_key_take_what_the_byte_by_byte_scan_takes(g: Generated, direction: Direction) -> None:
+def test_reads_of_one_key_take_what_the_byte_by_byte_scan_takes(
+    g: Generated, direction: Direction, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Frames of one key (their bytes changed, so the sieve checks many checksums) with the damage `damaged` draws,
-    now and then a frame of another key: the sieve decides those reads, or leaves them to the loop, as the
-    byte-by-byte scan would."""
+    now and then a frame of another key: the sieve decides those reads (of a few headers or more, here), or leaves
+    them to the loop, as the byte-by-byte scan would."""
+    from serialspec.runtime import stream as runtime  # noqa: PLC0415
+
+    monkeypatch.setattr(runtime, "_SIEVE_FROM", 4)
     frames = one_key_frames(g, direction)
     others = [e.frame for e in g.protocol.examples if e.direction == direction]
     header = g.protocol.framing.layouts[direction].header
@@ -176,7 +181,8 @@ def test_the_sieve_decides_a_read_of_frames_and_cut_frame_starts(monkeypatch: py
     stream = b"".join(
         [b"\x01\x02", *replies[:3], replies[4][:5], corrupt, replies[5][:2], *replies[5:39], replies[39][:6]]
     )
-    assert stream.count(b"\x05\x1c") > runtime._SIEVE_FROM
+    monkeypatch.setattr(runtime, "_SIEVE_FROM", 8)  # (the sieve for a read this short, as for the long ones)
+    assert len(stream) < 512  # (a longer read takes the batch scan)
     decided: list[object] = []
     sieve = runtime._sieve
 
@@ -186,7 +192,7 @@ def test_the_sieve_decides_a_read_of_frames_and_cut_frame_starts(monkeypatch: py
 
     monkeypatch.setattr(runtime, "_sieve", spy)
     found = fed(fs.StreamParser(Direction.RESPONSE), [stream])
-    assert len(decided) == 1 and decided[0] is not None
+    assert len(decided) == 1 and decided[0]
     assert found == fed(scanning(fs.StreamParser(Direction.RESPONSE)), [stream])
     assert found[0] == [fs.decode(r, Direction.RESPONSE) for r in replies[:3] + replies[5:39]]
     assert found[1] == (2, 2 + 5 + 8 + 2, replies[39][:6])  # (a header alone names no frame: no error)

@@ -15,7 +15,7 @@ the real frame inside it). So any split of a stream into reads gives the same fr
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from itertools import compress, islice
+from itertools import accumulate, compress, islice
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.message import TYPE_CHECKING, Message
@@ -269,18 +269,21 @@ _SHORTEST_RUN = 24
 _FIRST_RUN = 32
 _LONGEST_RUN = 1024
 # The sieve (see _sieve) decides the reads of more than _SIEVE_FROM headers (its fixed cost, a few dozen calls in C,
-# is about that many frames through the loop); after one it could not decide (frames of other keys in it, ...), the
+# is about that many frames through the loop); after a read it is not for (frames of other keys in it, ...), the
 # next _SIEVE_AGAIN reads take the plain loop.
-_SIEVE_FROM = 24
+_SIEVE_FROM = 64
 _SIEVE_AGAIN = 8
 _ZERO_ONLY = bytes((1, *bytes(255)))  # a translate table: 0 -> 1, any other byte -> 0
 
 
-def _sieve(current: _Candidate, pieces: list[bytes], end: int) -> tuple[list[Message], int, int, int] | None:
+def _sieve(
+    current: _Candidate, buffer: bytes, pieces: list[bytes]
+) -> tuple[list[Message], int, int, int] | tuple[()] | None:
     """Every piece of a read (the bytes after each header) decided at once, in C, as `_lean` decides them one by one,
     where the read holds frames of one size key (that of one of its first pieces) and cut frame starts: (the
     messages, corrupt candidates, bytes taken, where the bytes held back begin); None where it holds anything else
-    (a frame of another key, a cut frame start whose checksum holds, ...), which `_lean`'s loop decides.
+    (a frame of another key, ...), and () where this read has what a few do (a candidate whose bytes are not all
+    here), which `_lean`'s loop decides.
 
     A piece holding a whole frame of the key is a candidate as it is; a shorter one (a cut frame start, or bytes
     that name no frame) is one with the bytes after it, the next header's included, as the byte-by-byte scan reads
@@ -289,6 +292,7 @@ def _sieve(current: _Candidate, pieces: list[bytes], end: int) -> tuple[list[Mes
     integer (see below); the candidates of the key whose checksum holds are the read's frames, their messages
     unpacked at once by the run decoder. A last piece too short for its frame waits for its bytes."""
     leading = current.leading
+    end = len(buffer)
     for piece in islice(pieces, 1, 4):
         entry = current.sieves.get(piece[:leading])
         if entry is not None:
@@ -301,25 +305,28 @@ def _sieve(current: _Candidate, pieces: list[bytes], end: int) -> tuple[list[Mes
     last = pieces[-1]
     held = len(last) < rest  # the last candidate waits for its bytes
     if held and len(last) >= leading and last[:leading] != first:
-        return None  # the last piece may be whole (another key) or no frame
+        return ()  # the last piece may be whole (another key) or no frame
     body = pieces[1:-1] if held else pieces[1:]
     count = len(body)
     framed = [piece[:rest] for piece in body]
     short = bytes(map(len, framed)).translate(current.short_tables[rest])  # 1 where a piece holds no whole frame
     at = short.find(1)
-    while at >= 0:
-        joined = body[at]
-        if len(joined) + current.smallest < rest:  # a frame from the next header might end before this candidate
+    after: list[int] = []  # where each piece begins, once a piece is short
+    if at >= 0:
+        shortest = (
+            rest - current.smallest
+        )  # a frame from the next header may end before a candidate from a shorter piece
+        if shortest > 0 and min(len(piece) for piece in body if len(piece) < rest) < shortest:
             return None
-        index = at + 2  # the next piece
-        while len(joined) < rest:
-            if index >= len(pieces):
-                return None  # the candidate needs bytes not here yet
-            joined += header + pieces[index]
-            index += 1
-        framed[at] = joined[:rest]
-        at = short.find(1, at + 1)
+        after = list(accumulate(map(width.__add__, map(len, pieces))))
+        while (
+            at >= 0
+        ):  # the candidate's bytes run on into the next header and piece, as the byte-by-byte scan reads them
+            framed[at] = buffer[after[at] : after[at] + rest]
+            at = short.find(1, at + 1)
     frames = b"".join(framed)
+    if len(frames) != count * rest:
+        return ()  # a cut frame start's candidate needs bytes not here yet
     keyed = -1  # a byte per candidate, as an integer: 1 where its key is the sieve's
     for at, table in tables:  # each key byte, a column of the candidates
         keyed &= int.from_bytes(frames[at::rest].translate(table), "little")
@@ -333,8 +340,6 @@ def _sieve(current: _Candidate, pieces: list[bytes], end: int) -> tuple[list[Mes
     differ = int.from_bytes(sums, "little") ^ int.from_bytes(frames[rest - 1 :: rest], "little")
     checked = int.from_bytes(differ.to_bytes(count, "little").translate(_ZERO_ONLY), "little")
     passed = keyed & checked
-    if passed & int.from_bytes(short, "little"):
-        return None  # a cut frame start whose checksum holds: it takes the bytes of the frame after it
     ones = int.from_bytes(b"\x01" * count, "little")
     other = ones & ~keyed
     if other:  # candidates of another key: no frame, unless the key is another frame's
@@ -344,15 +349,39 @@ def _sieve(current: _Candidate, pieces: list[bytes], end: int) -> tuple[list[Mes
             if framed[at][:leading] in current.lean:
                 return None
             at = flags.find(1, at + 1)
-    good = passed.to_bytes(count, "little")
+    corrupt = keyed & ~checked
+    stop = -1  # where the last frame taken ends, once a cut frame start is taken (-1: none is)
+    taken = passed & int.from_bytes(short, "little")
+    if taken:
+        # A cut frame start whose checksum holds (one in 256): a frame, which takes the bytes of the pieces whose
+        # header lies inside it (their own frames and errors do not count), as the byte-by-byte scan does.
+        good_flags, corrupt_flags = bytearray(passed.to_bytes(count, "little")), corrupt.to_bytes(count, "little")
+        errors = corrupt.bit_count()
+        taken_flags = taken.to_bytes(count, "little")
+        at = taken_flags.find(1)
+        while at >= 0:
+            if good_flags[at]:  # (not inside a frame taken before it)
+                stop = after[at] - width + size
+                inside = at + 1
+                while inside < count and after[inside] - width < stop:
+                    good_flags[inside] = 0
+                    errors -= corrupt_flags[inside]
+                    inside += 1
+                if held and inside == count and after[count] - width < stop:  # the last piece too: no candidate
+                    held = False
+            at = taken_flags.find(1, at + 1)
+        good = bytes(good_flags)
+    else:
+        good = passed.to_bytes(count, "little")
+        errors = corrupt.bit_count()
     messages = list(compress(run(frames), good))
     if held:
         cut = end - width - len(last)
     else:  # keep a tail that could begin a header, unless the last frame taken ends after it begins
-        cut = end - width + 1
+        cut = max(end - width + 1, stop)
         if good[-1]:
             cut = max(cut, end - len(last) + rest)
-    return messages, (keyed & ~checked).bit_count(), len(messages) * size, cut
+    return messages, errors, len(messages) * size, cut
 
 
 def _candidate(frame_format: FrameFormat) -> _Candidate:
@@ -559,14 +588,15 @@ class StreamParser:
             if self._sieve_wait:
                 self._sieve_wait -= 1
             else:
-                sieved = _sieve(current, pieces, len(buffer))
-                if sieved is not None:
+                sieved = _sieve(current, buffer, pieces)
+                if sieved:
                     messages, errors, taken, cut = sieved
                     self._pending = buffer[cut:]
                     self.garbage += cut - taken
                     self.errors += errors
                     return messages
-                self._sieve_wait = _SIEVE_AGAIN  # a read it could not decide: the loop below for a while
+                if sieved is None:  # a read it is not for: the loop below for a while
+                    self._sieve_wait = _SIEVE_AGAIN
         lean, leading = current.lean, current.leading
         decode_at = current.decode
         smallest, end = self._smallest, len(buffer)

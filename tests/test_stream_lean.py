@@ -107,3 +107,92 @@ def test_reads_of_a_few_frames_take_the_lean_scan(g: Generated, direction: Direc
     calls = counting(parser)
     assert len(parser.feed(stream)) == 3 * len(frames)
     assert calls == [len(stream)]
+
+
+def one_key_frames(g: Generated, direction: Direction) -> list[bytes]:
+    """The example frames of the first key the sieve knows (frames checked in runs), or none."""
+    parser = g.package.StreamParser(direction)
+    current = parser._single
+    width = len(current.header)
+    by_key: dict[bytes, list[bytes]] = {}
+    for e in g.protocol.examples:
+        if e.direction == direction:
+            by_key.setdefault(e.frame[width : width + current.leading], []).append(e.frame)
+    return next((frames for key, frames in by_key.items() if key in current.sieves), [])
+
+
+SIEVED = [(g, d) for g, d in LEAN if one_key_frames(g, d)]
+
+
+def test_fashion_star_replies_take_the_sieve() -> None:
+    assert "fashionstar_uart:response" in [f"{g.protocol.name}:{d.value}" for g, d in SIEVED]
+
+
+@pytest.mark.parametrize(("g", "direction"), SIEVED, ids=[f"{g.protocol.name}:{d.value}" for g, d in SIEVED])
+def test_reads_of_one_key_take_what_the_byte_by_byte_scan_takes(
+    g: Generated, direction: Direction, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Frames of one key (their bytes changed, so the sieve checks many checksums) with the damage `damaged` draws,
+    now and then a frame of another key: the sieve decides those reads (of a few headers or more, here), or leaves
+    them to the loop, as the byte-by-byte scan would."""
+    from serialspec.runtime import stream as runtime  # noqa: PLC0415
+
+    monkeypatch.setattr(runtime, "_SIEVE_FROM", 4)
+    frames = one_key_frames(g, direction)
+    others = [e.frame for e in g.protocol.examples if e.direction == direction]
+    header = g.protocol.framing.layouts[direction].header
+
+    @given(st.data())
+    @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    def check(data: st.DataObject) -> None:
+        parts: list[bytes] = []
+        for _ in range(data.draw(st.integers(1, 80))):
+            frame = data.draw(st.sampled_from(frames))
+            kind = data.draw(st.integers(0, 19))
+            if kind < 3:  # a garbage run
+                parts.append(
+                    bytes(data.draw(st.lists(st.integers(0, 255) | st.sampled_from(list(header)), max_size=8)))
+                )
+            elif kind < 7:  # a cut frame start, the next frame right after
+                parts.append(data.draw(st.sampled_from(frames))[: data.draw(st.integers(1, len(frame) - 1))])
+            elif kind == 7:  # a byte changed
+                at = data.draw(st.integers(0, len(frame) - 1))
+                frame = frame[:at] + bytes([frame[at] ^ data.draw(st.integers(1, 255))]) + frame[at + 1 :]
+            elif kind == 8:
+                frame = data.draw(st.sampled_from(others))
+            parts.append(frame)
+        stream = b"".join(parts)
+        expected = fed(scanning(g.package.StreamParser(direction)), [stream])
+        assert fed(g.package.StreamParser(direction), [stream]) == expected, stream.hex(" ")
+        split = reads(data, stream)
+        assert fed(g.package.StreamParser(direction), split) == expected, (stream.hex(" "), [len(c) for c in split])
+
+    check()
+
+
+def test_the_sieve_decides_a_read_of_frames_and_cut_frame_starts(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A read of one key's frames, some after the cut start of another, one corrupt, the last one cut: the sieve
+    decides it whole (the loop is not run), with the loop's frames, errors, skipped and held bytes."""
+    import serialspec_protocols.fashionstar_uart as fs  # noqa: PLC0415
+    from serialspec.runtime import stream as runtime  # noqa: PLC0415
+
+    replies = [fs.encode(fs.ReadAngleResponse(servo_id=i, angle=40 * i - 900)) for i in range(40)]
+    corrupt = replies[3][:-1] + bytes([replies[3][-1] ^ 1])
+    stream = b"".join(
+        [b"\x01\x02", *replies[:3], replies[4][:5], corrupt, replies[5][:2], *replies[5:39], replies[39][:6]]
+    )
+    monkeypatch.setattr(runtime, "_SIEVE_FROM", 8)  # (the sieve for a read this short, as for the long ones)
+    assert len(stream) < 512  # (a longer read takes the batch scan)
+    decided: list[object] = []
+    sieve = runtime._sieve
+
+    def spy(*args: Any) -> Any:
+        decided.append(sieve(*args))
+        return decided[-1]
+
+    monkeypatch.setattr(runtime, "_sieve", spy)
+    found = fed(fs.StreamParser(Direction.RESPONSE), [stream])
+    assert len(decided) == 1 and decided[0]
+    assert found == fed(scanning(fs.StreamParser(Direction.RESPONSE)), [stream])
+    assert found[0] == [fs.decode(r, Direction.RESPONSE) for r in replies[:3] + replies[5:39]]
+    assert found[1] == (2, 2 + 5 + 8 + 2, replies[39][:6])  # (a header alone names no frame: no error)

@@ -15,7 +15,7 @@ the real frame inside it). So any split of a stream into reads gives the same fr
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from itertools import islice
+from itertools import accumulate, compress, islice
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.message import TYPE_CHECKING, Message
@@ -94,6 +94,10 @@ class FrameFormat:
         return f"FrameFormat({values})"
 
 
+# what _sieve checks a key's frames with (see _Candidate.sieves)
+_Sieve = tuple[bytes, int, int, Callable[[bytes], Iterable[Message]], tuple[tuple[int, bytes], ...]]
+
+
 class _Candidate:
     """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
 
@@ -124,6 +128,9 @@ class _Candidate:
         "tails",
         "leading",
         "lean",
+        "sieves",
+        "short_tables",
+        "lane_sums",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -196,16 +203,31 @@ class _Candidate:
         leading = sorted(key_at) == list(range(width, width + len(key_at)))
         self.leading = len(key_at) if leading and self.splittable and not self.shifts and not self.ranges else 0
         self.lean: dict[bytes, tuple[int, int, Callable[[bytes, int], Message | None] | None]] = {}
+        # The sieve (see _sieve), for the keys whose frames are checked in runs: their bytes -> (those bytes, frame
+        # size, bytes after the header, run decoder, and for each key byte its offset in the piece and a translate
+        # table taking its value to 1 and any other to 0).
+        self.sieves: dict[bytes, _Sieve] = {}
         if self.leading:
             for key, size in self.frame_sizes.items():
                 first = bytes(key >> key_at[offset] & 0xFF for offset in sorted(key_at))
                 self.lean[first] = (size, size - width, self.fixed.get(key))
+                run = self.runs.get(key)
+                if run is not None and self.leading < size - width <= 257:  # no 16-bit lane of _sieve's sums overflows
+                    tables = tuple((at, bytes(value == byte for value in range(256))) for at, byte in enumerate(first))
+                    self.sieves[first] = (first, size, size - width, run, tables)
+        # by frame size after the header: a translate table from a piece's first bytes' length to 1 when shorter
+        self.short_tables = {rest: bytes(n < rest for n in range(256)) for _, _, rest, *_ in self.sieves.values()}
         self.sum_from, self.sum_table = 0, b""
         if summed is not None:
             covered_from, invert = summed
             constant = sum(header[covered_from:])
             self.sum_from = max(0, covered_from - width)
             self.sum_table = bytes((constant + value) & 0xFF ^ (0xFF if invert else 0) for value in range(256))
+        # by count of bytes summed: 1 + L + L^2 + ..., L a 16-bit lane
+        self.lane_sums = {
+            rest - 1 - self.sum_from: sum(1 << 16 * i for i in range(rest - 1 - self.sum_from))
+            for _, _, rest, *_ in self.sieves.values()
+        }
 
     def plausible(self, buffer: bytes, position: int) -> bool:
         """Every frame-level value with a declared range holds a value in it (or the one also allowed)."""
@@ -246,6 +268,120 @@ _RUNS_AGAIN = 8
 _SHORTEST_RUN = 24
 _FIRST_RUN = 32
 _LONGEST_RUN = 1024
+# The sieve (see _sieve) decides the reads of more than _SIEVE_FROM headers (its fixed cost, a few dozen calls in C,
+# is about that many frames through the loop); after a read it is not for (frames of other keys in it, ...), the
+# next _SIEVE_AGAIN reads take the plain loop.
+_SIEVE_FROM = 64
+_SIEVE_AGAIN = 8
+_ZERO_ONLY = bytes((1, *bytes(255)))  # a translate table: 0 -> 1, any other byte -> 0
+
+
+def _sieve(
+    current: _Candidate, buffer: bytes, pieces: list[bytes]
+) -> tuple[list[Message], int, int, int] | tuple[()] | None:
+    """Every piece of a read (the bytes after each header) decided at once, in C, as `_lean` decides them one by one,
+    where the read holds frames of one size key (that of one of its first pieces) and cut frame starts: (the
+    messages, corrupt candidates, bytes taken, where the bytes held back begin); None where it holds anything else
+    (a frame of another key, ...), and () where this read has what a few do (a candidate whose bytes are not all
+    here), which `_lean`'s loop decides.
+
+    A piece holding a whole frame of the key is a candidate as it is; a shorter one (a cut frame start, or bytes
+    that name no frame) is one with the bytes after it, the next header's included, as the byte-by-byte scan reads
+    it: no frame from the next header can end before it (it would be decided first otherwise: None). Each key byte
+    is a column of the candidates laid end to end, checked against its value; each 8-bit sum is read from one big
+    integer (see below); the candidates of the key whose checksum holds are the read's frames, their messages
+    unpacked at once by the run decoder. A last piece too short for its frame waits for its bytes."""
+    leading = current.leading
+    end = len(buffer)
+    for piece in islice(pieces, 1, 4):
+        entry = current.sieves.get(piece[:leading])
+        if entry is not None:
+            break
+    else:
+        return None
+    first, size, rest, run, tables = entry
+    header = current.header
+    width = len(header)
+    last = pieces[-1]
+    held = len(last) < rest  # the last candidate waits for its bytes
+    if held and len(last) >= leading and last[:leading] != first:
+        return ()  # the last piece may be whole (another key) or no frame
+    body = pieces[1:-1] if held else pieces[1:]
+    count = len(body)
+    framed = [piece[:rest] for piece in body]
+    short = bytes(map(len, framed)).translate(current.short_tables[rest])  # 1 where a piece holds no whole frame
+    at = short.find(1)
+    after: list[int] = []  # where each piece begins, once a piece is short
+    if at >= 0:
+        shortest = (
+            rest - current.smallest
+        )  # a frame from the next header may end before a candidate from a shorter piece
+        if shortest > 0 and min(len(piece) for piece in body if len(piece) < rest) < shortest:
+            return None
+        after = list(accumulate(map(width.__add__, map(len, pieces))))
+        while (
+            at >= 0
+        ):  # the candidate's bytes run on into the next header and piece, as the byte-by-byte scan reads them
+            framed[at] = buffer[after[at] : after[at] + rest]
+            at = short.find(1, at + 1)
+    frames = b"".join(framed)
+    if len(frames) != count * rest:
+        return ()  # a cut frame start's candidate needs bytes not here yet
+    keyed = -1  # a byte per candidate, as an integer: 1 where its key is the sieve's
+    for at, table in tables:  # each key byte, a column of the candidates
+        keyed &= int.from_bytes(frames[at::rest].translate(table), "little")
+    # Each candidate's 8-bit sum: its bytes spread to 16-bit lanes of one big integer, times 1 + L + L^2 + ... (L
+    # a lane), so that the lane of its last summed byte adds up its summed bytes (no lane overflows into the next).
+    lanes = bytearray(2 * len(frames))
+    lanes[::2] = frames
+    summed = rest - 1 - current.sum_from
+    sums = (int.from_bytes(lanes, "little") * current.lane_sums[summed]).to_bytes(2 * (len(frames) + summed), "little")
+    sums = sums[2 * (rest - 2) :: 2 * rest][:count].translate(current.sum_table)
+    differ = int.from_bytes(sums, "little") ^ int.from_bytes(frames[rest - 1 :: rest], "little")
+    checked = int.from_bytes(differ.to_bytes(count, "little").translate(_ZERO_ONLY), "little")
+    passed = keyed & checked
+    ones = int.from_bytes(b"\x01" * count, "little")
+    other = ones & ~keyed
+    if other:  # candidates of another key: no frame, unless the key is another frame's
+        flags = other.to_bytes(count, "little")
+        at = flags.find(1)
+        while at >= 0:
+            if framed[at][:leading] in current.lean:
+                return None
+            at = flags.find(1, at + 1)
+    corrupt = keyed & ~checked
+    stop = -1  # where the last frame taken ends, once a cut frame start is taken (-1: none is)
+    taken = passed & int.from_bytes(short, "little")
+    if taken:
+        # A cut frame start whose checksum holds (one in 256): a frame, which takes the bytes of the pieces whose
+        # header lies inside it (their own frames and errors do not count), as the byte-by-byte scan does.
+        good_flags, corrupt_flags = bytearray(passed.to_bytes(count, "little")), corrupt.to_bytes(count, "little")
+        errors = corrupt.bit_count()
+        taken_flags = taken.to_bytes(count, "little")
+        at = taken_flags.find(1)
+        while at >= 0:
+            if good_flags[at]:  # (not inside a frame taken before it)
+                stop = after[at] - width + size
+                inside = at + 1
+                while inside < count and after[inside] - width < stop:
+                    good_flags[inside] = 0
+                    errors -= corrupt_flags[inside]
+                    inside += 1
+                if held and inside == count and after[count] - width < stop:  # the last piece too: no candidate
+                    held = False
+            at = taken_flags.find(1, at + 1)
+        good = bytes(good_flags)
+    else:
+        good = passed.to_bytes(count, "little")
+        errors = corrupt.bit_count()
+    messages = list(compress(run(frames), good))
+    if held:
+        cut = end - width - len(last)
+    else:  # keep a tail that could begin a header, unless the last frame taken ends after it begins
+        cut = max(end - width + 1, stop)
+        if good[-1]:
+            cut = max(cut, end - len(last) + rest)
+    return messages, errors, len(messages) * size, cut
 
 
 def _candidate(frame_format: FrameFormat) -> _Candidate:
@@ -276,6 +412,7 @@ class StreamParser:
         # whether the last batch scan took half of its frames or more in runs; frames runs took in it; long reads
         # the lean scan took since (see feed)
         self._runs_pay, self._ran, self._lean_reads = True, 0, 0
+        self._sieve_wait = 0  # reads the sieve skips (see _lean)
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
 
@@ -441,10 +578,25 @@ class StreamParser:
         bytes right after it, for a read of a few frames: split at every header, the usual piece (the bytes after a
         header) begins with a whole frame: one slice and one lookup find its size and decoder, and its length says
         no header starts inside it (no frame can complete before it), so it is taken or refused on the spot. A
-        piece whose key bytes name no frame is no frame. Every other candidate goes through `_decide`."""
+        piece whose key bytes name no frame is no frame. Every other candidate goes through `_decide`.
+
+        Where the format's frames are checked in runs, `_sieve` first tries to decide every piece at once."""
         header = current.header
         width = len(header)
         pieces = buffer.split(header)
+        if len(pieces) > _SIEVE_FROM and current.sieves:
+            if self._sieve_wait:
+                self._sieve_wait -= 1
+            else:
+                sieved = _sieve(current, buffer, pieces)
+                if sieved:
+                    messages, errors, taken, cut = sieved
+                    self._pending = buffer[cut:]
+                    self.garbage += cut - taken
+                    self.errors += errors
+                    return messages
+                if sieved is None:  # a read it is not for: the loop below for a while
+                    self._sieve_wait = _SIEVE_AGAIN
         lean, leading = current.lean, current.leading
         decode_at = current.decode
         smallest, end = self._smallest, len(buffer)

@@ -546,6 +546,28 @@ assert _long is not None
 _long["layouts"]["long"]["elements"]["checksum"] |= {"algorithm": "crc", "crc": DVB_S2}
 
 # A content sent without its trailing zero bytes (MAVLink v2)
+# an error reply told by its header (MSP's `$M!` for `$M>`): the refused code in the command element, no content
+CASES["frame: error header (error_value), an error reply without fields"] = Case(
+    {"v": "u8"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {
+                "role": "header",
+                "value": {"request": "24 4d 3c", "response": "24 4d 3e"},
+                "error_value": "24 4d 21",
+            },
+            "length": {"role": "length", "type": "u8"},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["length", "content"]},
+        }
+    },
+    {"refused": {"response": {"error_reply": True, "fields": {}}}},
+)
+C_REFUSES["frame: error header (error_value), an error reply without fields"] = WIRESHARK_REFUSES[
+    "frame: error header (error_value), an error reply without fields"
+] = "error replies told by their header (`error_value`)"
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},

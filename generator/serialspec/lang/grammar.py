@@ -501,8 +501,9 @@ MESSAGE = Obj(
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
-            "under the request's code plus the command element's `error_flag` (Modbus exception replies). Its "
-            "message carries the code of the refused request in a value named after the command element."
+            "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
+            "under the header's `error_value` (MSP's `$M!`). Its message carries the code of the refused request "
+            "in a value named after the command element; clients raise DeviceError for it."
         ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
@@ -787,6 +788,13 @@ FRAME_ELEMENT = Obj(
         "error_flag": Int(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
+        ),
+        "error_value": Str(
+            "header: the bytes a response starts with instead of its `value` when it refuses the request (MSP: "
+            "`24 4d 21`, `$M!` where replies carry `$M>`); such a reply has the response's layout, its command "
+            "element carries the refused request's code and its content is that of the command whose response is "
+            "the `error_reply`.",
+            example="24 4d 21",
         ),
         "reply_code": Str(
             "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
@@ -1423,8 +1431,8 @@ DEVICE = Obj(
                 "unsupported": MapOf(
                     Num(),
                     "Reply values for a request whose code no command has, recognised when it arrives whole and "
-                    "its checksum verifies (Modbus exception_code: 1, illegal function); needs the protocol's "
-                    "error reply and frames without a header.",
+                    "its checksum verifies (Modbus exception_code: 1, illegal function; MSP: `{}`, the `$M!` "
+                    "reply, which carries no values); needs the protocol's error reply.",
                 ),
             },
             description=(

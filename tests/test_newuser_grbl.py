@@ -144,23 +144,51 @@ def test_a_dollar_command(tmp_path: Path) -> None:
     ), lines
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding: one `start`, one `separator` per framing: GRBL's status report `<Idle|MPos:1.000,2.000,3.000|"
-    "FS:0,0>` starts with `<` where other lines have no start, separates fields with `|`, names them with `:` and "
-    "separates a field's numbers with `,`",
-)
 def test_a_status_report(tmp_path: Path) -> None:
+    """Found here: one `start`, one `separator` per framing, so GRBL's status report `<Idle|MPos:1.000,2.000,3.000|
+    FS:0,0>` (a `<` where other lines have no start, fields separated by `|`, named with `:`, a field's numbers
+    separated by `,`) could not be said. A message's own `text:` says it; its fields are found by their labels."""
     extra = """  status:
     code: Idle
     response:
       unsolicited: true
+      text: {start: "<", end: ">", separator: "|", named: ":", list: ","}
       fields:
-        mpos: {type: repeat, count: 3, fields: {axis: {type: decimal, precision: 3}}}
+        mpos: {label: MPos, type: repeat, count: 3, fields: {axis: {type: decimal, precision: 3}}}
+        wpos: {label: WPos, type: repeat, count: 3, fields: {axis: {type: decimal, precision: 3}}}
+        feed: {label: FS, type: repeat, count: 2, fields: {value: integer}}
+        line: {label: Ln, type: integer}
 """
     path = spec(tmp_path, extra)
     load_protocol(str(path), "grbl")
-    assert decode_json(path, "<Idle|MPos:1.000,2.000,3.000|FS:0,0>")["command"] == "status"
+    report = decode_json(path, "<Idle|MPos:1.000,2.000,3.000|FS:0,0>")
+    assert report["command"] == "status"
+    assert report["fields"]["mpos"] == [{"axis": "1.000"}, {"axis": "2.000"}, {"axis": "3.000"}]
+    assert report["fields"]["wpos"] == [] and report["fields"]["line"] == ""  # labels absent
+    from conftest import generate_and_import
+
+    for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
+        del sys.modules[name]  # another test's spec of the same protocol name
+    grbl = generate_and_import(path, tmp_path / "out", "grbl")
+    line = b"<Idle|MPos:1.000,2.000,3.000|FS:0,0>\r\n"
+    assert grbl.encode(grbl.decode(line)) == line
+    status = grbl.decode(b"<Idle|Ln:7|FS:500,8000|WPos:0.000,-1.500,2.250>\r\n")  # labels in any order
+    assert grbl.encode(status) == b"<Idle|WPos:0.000,-1.500,2.250|FS:500,8000|Ln:7>\r\n"  # written in the spec's
+    assert grbl.decode(grbl.encode(status)) == status
+    assert status.line == 7 and [f.value for f in status.feed] == [500, 8000]
+    stream = b"ok\r\n<Idle|MPos:1.000,2.000,3.000|FS:0,0>\r\nerror:9\r\n"
+    parser = grbl.StreamParser()
+    found = [m for byte in stream for m in parser.feed(bytes([byte]))]
+    assert [type(m).__name__ for m in found] == ["OkResponse", "StatusResponse", "ErrorResponse"]
+    for bad, reason in (
+        ("<Idle|Bf:15,128>", "unknown label 'Bf'"),
+        ("<Idle|Ln:1|Ln:2>", "label 'Ln' sent twice"),
+        ("<Idle|MPos:1.000,2.000>", "mpos has 2 values, expected 3"),
+    ):
+        run = subprocess.run(
+            [sys.executable, "-m", "serialspec", "decode", str(path), bad], capture_output=True, text=True
+        )
+        assert run.returncode != 0 and reason in run.stderr and "Traceback" not in run.stderr, run.stderr
 
 
 def test_codes_with_question_marks_compile_as_c99_without_trigraphs(tmp_path: Path) -> None:

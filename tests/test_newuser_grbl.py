@@ -1,6 +1,7 @@
 """GRBL 1.1 (a CNC controller's text protocol: `ok`, `error:N`, `ALARM:N`, `<Idle|MPos:0.000,0.000,0.000|FS:0,0>`),
 tried from the user docs alone. There is no PyPI peer worth the name, so there is no spec under tests/specs: what the
-text language takes (`ok`, `error:20`) works, and each thing it cannot take is a strict xfail naming the gap."""
+text language takes (`ok`, `error:20`, the status report in its own text layout) works, and each thing it cannot take
+is a strict xfail naming the gap. examples/grbl/grbl.yaml is the tutorial's spec of the status report."""
 
 from __future__ import annotations
 
@@ -210,3 +211,18 @@ def test_codes_with_question_marks_compile_as_c99_without_trigraphs(tmp_path: Pa
     flags = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", str(source), "-o", str(tmp_path / "o")]
     run = subprocess.run([gcc, *flags], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
+
+
+def test_the_client_asks_the_sim_for_a_status_report(tmp_path: Path) -> None:
+    """examples/grbl/grbl.yaml: `?` is answered by the status report, which the simulator writes in its own text
+    layout and the client reads back by its labels."""
+    from conftest import ROOT, generate_and_import
+    from sim_process import serve
+
+    path = ROOT / "examples" / "grbl" / "grbl.yaml"
+    for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
+        del sys.modules[name]  # another test's spec of the same protocol name
+    grbl = generate_and_import(path, tmp_path / "out", "grbl")
+    with serve(str(path)) as port, grbl.Client(port) as client:
+        status = client.report(timeout=5)
+    assert isinstance(status, grbl.StatusResponse) and status.line == 7

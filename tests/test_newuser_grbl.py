@@ -9,6 +9,7 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 from serialspec.lang import load_protocol
@@ -226,3 +227,40 @@ def test_the_client_asks_the_sim_for_a_status_report(tmp_path: Path) -> None:
     with serve(str(path)) as port, grbl.Client(port) as client:
         status = client.report(timeout=5)
     assert isinstance(status, grbl.StatusResponse) and status.line == 7
+
+
+def test_status_reports_round_trip_and_stream_however_split(tmp_path: Path) -> None:
+    """Any values, any labels left out: decode(encode(m)) == m, and the stream parser gives the same messages
+    however the bytes are split into reads."""
+    from conftest import ROOT, generate_and_import
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
+        del sys.modules[name]  # another test's spec of the same protocol name
+    grbl = generate_and_import(ROOT / "examples" / "grbl" / "grbl.yaml", tmp_path / "out", "grbl")
+    axis = st.decimals(-9999, 9999, places=3).map(lambda d: grbl.StatusResponseMpos(axis=d))
+    waxis = st.decimals(-9999, 9999, places=3).map(lambda d: grbl.StatusResponseWpos(axis=d))
+    feed = st.integers(0, 99999).map(lambda v: grbl.StatusResponseFeed(value=v))
+    status = st.builds(
+        grbl.StatusResponse,
+        mpos=st.one_of(st.just(()), st.tuples(axis, axis, axis)),
+        wpos=st.one_of(st.just(()), st.tuples(waxis, waxis, waxis)),
+        feed=st.one_of(st.just(()), st.tuples(feed, feed)),
+        line=st.one_of(st.none(), st.integers(0, 9999999)),
+    )
+
+    @settings(max_examples=60, deadline=None)
+    @given(reports=st.lists(status, min_size=1, max_size=3), cuts=st.lists(st.integers(1, 400), max_size=6))
+    def check(reports: list[Any], cuts: list[int]) -> None:
+        data = b"ok\r\n".join(grbl.encode(r) for r in reports)
+        for report in reports:
+            assert grbl.decode(grbl.encode(report)) == report
+        parser, found, at = grbl.StreamParser(), [], 0
+        for cut in sorted(set(cuts)):
+            found += parser.feed(data[at:cut])
+            at = max(at, cut)
+        found += parser.feed(data[at:])
+        assert [m for m in found if isinstance(m, grbl.StatusResponse)] == reports
+
+    check()

@@ -91,13 +91,11 @@ def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, .
 
 def refuse_by_command(protocol: Protocol) -> None:
     """Unsupported for frames read with the request they answer, in targets that take each frame alone (the C
-    decoder, the Wireshark dissector), and (not yet written there) for error replies told by their header."""
+    decoder, the Wireshark dissector)."""
     if protocol.framing.by_command:
         raise Unsupported("layouts chosen by command (`layout:`)")
     if protocol.framing.from_request:
         raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
-    if protocol.error_reply is not None and not protocol.error_reply.flag:
-        raise Unsupported("error replies told by their header (`error_value`)")
 
 
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:

@@ -196,8 +196,10 @@ def optional_values(fields: dict[str, Any], optional: tuple[Any, ...]) -> st.Sea
 
 
 def refused_code(protocol: Protocol, message: Message) -> dict[str, st.SearchStrategy[int]]:
-    """An error reply also carries the code of the request it refuses (any code without the error flag)."""
+    """An error reply also carries the code of the request it refuses (any code without the error flag; under an
+    error header any code of the command element)."""
     error = protocol.error_reply
     if not message.error_reply or error is None:
         return {}
-    return {error.element: st.integers(0, error.flag - 1)}
+    element = next(e for e in protocol.layout(message).elements if e.name == error.element)
+    return {error.element: st.integers(0, error.flag - 1 if error.flag else int(element.maximum))}

@@ -546,6 +546,28 @@ assert _long is not None
 _long["layouts"]["long"]["elements"]["checksum"] |= {"algorithm": "crc", "crc": DVB_S2}
 
 # A content sent without its trailing zero bytes (MAVLink v2)
+# an error reply told by its header (MSP's `$M!` for `$M>`): the refused code in the command element, no content
+CASES["frame: error header (error_value), an error reply without fields"] = Case(
+    {"v": "u8"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {
+                "role": "header",
+                "value": {"request": "24 4d 3c", "response": "24 4d 3e"},
+                "error_value": "24 4d 21",
+            },
+            "length": {"role": "length", "type": "u8"},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["length", "content"]},
+        }
+    },
+    {"refused": {"response": {"error_reply": True, "fields": {}}}},
+)
+C_REFUSES["frame: error header (error_value), an error reply without fields"] = (
+    "error replies told by their header (`error_value`)"
+)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},
@@ -1308,3 +1330,64 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         # both directions in one stream (a monitor's): the answer right after its request is the response
         both = package.StreamParser()
         assert both.feed(package.encode(asked) + frame) == [asked, answer]
+
+
+def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
+    """`text:` (a message's own start, end, separator, labels and lists) beside the case's plain sentences: C and
+    Wireshark refuse it in one line; the markdown page shows the labels; the generated package round-trips random
+    messages (labels left out where a value is None) and finds them byte by byte among garbage and other sentences;
+    the simulator sends it."""
+    from serialspec.backends import Unsupported, emit
+    from serialspec.runtime.text import TextField, TextRepeat
+    from test_text_frames import sentence_values
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["report"] = {
+        "code": "RP",
+        "title": "A report in its own text",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "<", "end": ">", "separator": "|", "named": "=", "list": ","},
+            "fields": {
+                "lvl": {"label": "LV", "type": "integer", "range": [0, 99]},
+                "pos": {
+                    "label": "P",
+                    "type": "repeat",
+                    "count": 2,
+                    "fields": {"x": {"type": "decimal", "precision": 1}},
+                },
+                "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
+            },
+        },
+    }
+    case["device"]["sends"] = {"report": {"every": 100, "values": {"lvl": "level"}}}
+    protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    assert protocol.text is not None
+    files: dict[str, str] = {}
+    for emitter in emitters():
+        if emitter.name in ("c", "wireshark"):
+            with pytest.raises(Unsupported, match=r"^a message's own text layout \(`text:`\)$"):
+                emitter.files(protocol)
+            continue
+        emitted = emit(emitter, protocol)
+        assert emitter.verify is None or emitter.verify(protocol, emitted) == []
+        files.update(emitted)
+    docs = files["docs/matrix_text.md"]
+    assert "| `LV=` | `lvl` |" in docs and "`sats[].n`" in docs and "Its own text inside the frame: `<`" in docs
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        sentence = package.FRAMING.sentence("RP", "response")
+        assert all(isinstance(f, TextField | TextRepeat) and f.label for f in sentence.fields)
+        frames, messages = b"", []
+        other = package.encode(package.AnswerResponse(talker="A", ok=package.Side.NORTH))
+        for values in st_examples(sentence_values(sentence), 20):
+            message = package.ReportResponse.from_fields(values, talker="B")
+            frame = package.encode(message)
+            assert frame.startswith(b"#<BRP") and package.decode(frame, "response") == message
+            frames += b"\x00garbage#\n" + frame + other
+            messages += [message, package.AnswerResponse(talker="A", ok=package.Side.NORTH)]
+        parser = package.StreamParser("response")
+        assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        sent = [package.decode(frame, "response") for _, frame in device.due()]
+        assert any(isinstance(m, package.ReportResponse) and m.lvl == 0 for m in sent), sent

@@ -95,6 +95,26 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "name: {type: string}"), "a string needs `size`"),
         (("angle: i16", "name: {type: cstring, size: 4}"), "a cstring ends at its NUL byte"),
         (("type: u8}", "type: u8, error_flag: 0x80}"), "`error_flag` needs a command whose response is marked"),
+        (('value: "AA 55"}', 'value: "AA 55", error_value: "AA 56"}'), "`error_value` needs a command whose"),
+        (('value: "AA 55"}', 'value: "AA 55", error_value: "AA"}'), "as many bytes as the response header (2)"),
+        (('value: "AA 55"}', 'value: "AA 55", error_value: "AA 55"}'), "must differ from the response header"),
+        (('value: "AA 55"}', 'value: "AA 55", error_value: "AA 5Z"}'), "not a hex byte"),
+        (
+            ("role: command, type: u8}", "role: command, type: u8, error_value: 'AA'}"),
+            "`error_value` goes on the header",
+        ),
+        (
+            (
+                '"AA 55"}\n    code: {role: command, type: u8}',
+                '"AA 55", error_value: "AA 56"}\n    code: {role: command, error_flag: 1}',
+            ),
+            "give either the command element's `error_flag` or the header's `error_value`",
+        ),
+        (
+            ("    request:", "    request:\n      text: {start: <, separator: '|'}"),
+            "`text` belongs to messages of text",
+        ),
+        (("angle: i16", "angle: {type: i16, label: A}"), "`label` belongs to fields of text frames"),
         (("angle: i16", "rc: {type: array, of: u11, count: n}"), "an array of u11 items needs a fixed `count`"),
         (("angle: i16", "rc: {type: array, of: u65, count: 2}"), "u65: packed integers take 1..64 bits"),
         (("angle: i16", "rc: {type: array, of: u11, count: 2, range: [0, 4096]}"), "does not fit u11 (0..2047)"),

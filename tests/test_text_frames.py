@@ -445,6 +445,21 @@ commands:
         (("prn: integer}}", "prn: integer}}\n        last: text"), "sats: a repeat with `max_count` must be the last"),
         (("max_count: 4", "max_count: 4, count: 2"), "sats: a repeat needs `count` (always sent) or `max_count`"),
         (("commands:", "enums: {e: {values: {a: 1}}}\ncommands:"), "enums: `enums` is not available in text frames"),
+        (
+            ("    response:\n", "    response:\n      text: {start: A, separator: '|'}\n"),
+            "text.start: a message's text",
+        ),
+        (
+            ("    response:\n", "    response:\n      text: {start: <, separator: '||'}\n"),
+            "text.separator: `separator` is one",
+        ),
+        (
+            ("    response:\n", "    response:\n      text: {start: <, separator: '*'}\n"),
+            "text: `separator`, `named` and",
+        ),
+        (("    response:\n", "    response:\n      text: {start: <, separator: '|', named: ':'}\n"), "needs a `label`"),
+        (("    response:\n", "    response:\n      text: {start: <, separator: '|'}\n"), "needs `text.list`"),
+        (("lat: {type: angle,", "lat: {label: LAT, type: angle,"), "lat.label: a label needs `text: {named: ...}`"),
     ],
 )
 def test_text_spec_mistakes_are_one_line_each(change: tuple[str, str], expected: str) -> None:

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "8734ff3f648f4e0da5a2b88b5a399a07c0606d222699364b8f207c593ce42ff7"
+#define CRSF_SPEC_SHA256 "d034fa076186a36c52fc3db7d619bee828604ced6a9454b544eda8efd4dcc383"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "5775e3726fe197bb3054a42668701774679d4ce2fff5d38526025a3e2652fd7d"
+#define DYNAMIXEL_P2_SPEC_SHA256 "34a89aa29daa8f6bb2b26c26b1bec2c41640d3113b9b67cfdb8fd013cf82c75b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "36395821dfd8d579013d17d8a803d990b84bea838feb43cca4a3796169e69235"
+#define FEETECH_SMS_SPEC_SHA256 "a2bc67441048607f28ae22652708143c21dc624f685908e61d132980c61be40f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

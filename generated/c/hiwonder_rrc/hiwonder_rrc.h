@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "d7f33dad6e3e11d648a467e476019d66ceb0e6b48222fe3edc460ecf502a7c8d"
+#define HIWONDER_RRC_SPEC_SHA256 "99319681cf50fb9f7844a361fd13d1c5d6d910a64088e918635fd98bb7d6855f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

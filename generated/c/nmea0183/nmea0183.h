@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "c46b8665b7f0ffa1444fbe08881d6cff9fbe62aabdb3df08441743681b4a1dbd"
+#define NMEA0183_SPEC_SHA256 "9fea1eaabcdeba98bf38a819a82d78e2eaf8f25f405f98f856c99e5b4bdc2e3d"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "bd337133bf629c8a8444d50757525235ce58fe1d1f0d4ecfd968bd00a147d695"
+#define VESC_SPEC_SHA256 "377dd4927d8fc53512a2eef1d397b0a3f096ceeadd7f6ffe297573bf6d308f6d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -1700,7 +1700,8 @@ end
 
 -- --- frames ----------------------------------------------------------------------------------------------------------
 
-local function entry_of(direction, code)
+local function entry_of(direction, code, layout)
+  if layout.error then return direction.codes.error end -- an error header's layout: the error reply
   if code == nil then return direction.codes.none end
   if direction.error_flag and band(code, direction.error_flag) ~= 0 then return direction.codes.error end
   return direction.codes[code]
@@ -1747,7 +1748,7 @@ local function frame_size(direction, layout, data, pos)
     if element.constant then
       if bytes ~= element.constant then return nil end
     elseif element.role == "command" then
-      entry = entry_of(direction, unsigned(bytes, element.big))
+      entry = entry_of(direction, unsigned(bytes, element.big), layout)
       if entry == nil then return nil end
     elseif element.role == "address" or element.role == "status" or element.role == "value" then
       if not plausible(element, unsigned(bytes, element.big)) then return nil end
@@ -1910,7 +1911,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     if element.role == "command" then code = unsigned(plain[index], element.big) end
     if element.role == "content" then content_index = index end
   end
-  entry = entry or entry_of(direction, code)
+  entry = entry or entry_of(direction, code, layout)
   if entry == nil then error(string.format("no command %s in this direction", tostring(code)), 0) end
   local message = entry.message
   if entry.subs then

@@ -363,6 +363,12 @@ _FIELD_LONG: dict[str, Shape] = {
         "repeated `count` times, or up to `max_count` times at the end); an empty field is None."
     ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
+    "label": Str(
+        "Text frames, in a message whose `text` has `named`: the label the field's value follows (GRBL's `MPos` in "
+        "`MPos:1.000,2.000,3.000`). Labelled fields are found by their label in any order; a label absent from a "
+        "frame leaves its field None (a repeat: empty) and encode leaves out the fields that are None.",
+        example="MPos",
+    ),
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
@@ -492,17 +498,41 @@ OPTIONAL_WHEN = Obj(
     description="The reply is sent only while a device parameter compares true (give one comparison).",
 )
 
+TEXT_LAYOUT = Obj(
+    {
+        "start": Str(
+            "What the message's text starts with, right after the framing's own start (GRBL's status report: `<`); "
+            "not a letter, digit or character of a text code: frames are told apart by it.",
+            example="<",
+        ),
+        "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
+        "separator": Str("One character between the code and the fields, and between fields (`|`).", example="|"),
+        "named": Str(
+            "One character between a field's `label` and its value (`:`): every field has a label and is found "
+            "by it, in any order.",
+            example=":",
+        ),
+        "list": Str("One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`).", example=","),
+    },
+    required=("start", "separator"),
+    description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
+    "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
+    "checksum and line end stay the framing's.",
+)
+
 MESSAGE = Obj(
     {
         "description": Str(TEXT.description, example="Sent once the move has finished."),
         "fields": FIELDS,
+        "text": TEXT_LAYOUT,
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
-            "under the request's code plus the command element's `error_flag` (Modbus exception replies). Its "
-            "message carries the code of the refused request in a value named after the command element."
+            "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
+            "under the header's `error_value` (MSP's `$M!`). Its message carries the code of the refused request "
+            "in a value named after the command element; clients raise DeviceError for it."
         ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
@@ -787,6 +817,13 @@ FRAME_ELEMENT = Obj(
         "error_flag": Int(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
+        ),
+        "error_value": Str(
+            "header: the bytes a response starts with instead of its `value` when it refuses the request (MSP: "
+            "`24 4d 21`, `$M!` where replies carry `$M>`); such a reply has the response's layout, its command "
+            "element carries the refused request's code and its content is that of the command whose response is "
+            "the `error_reply`.",
+            example="24 4d 21",
         ),
         "reply_code": Str(
             "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
@@ -1423,8 +1460,8 @@ DEVICE = Obj(
                 "unsupported": MapOf(
                     Num(),
                     "Reply values for a request whose code no command has, recognised when it arrives whole and "
-                    "its checksum verifies (Modbus exception_code: 1, illegal function); needs the protocol's "
-                    "error reply and frames without a header.",
+                    "its checksum verifies (Modbus exception_code: 1, illegal function; MSP: `{}`, the `$M!` "
+                    "reply, which carries no values); needs the protocol's error reply.",
                 ),
             },
             description=(

@@ -83,6 +83,7 @@ class Layout:
     present: frozenset[str] = frozenset()  # a variant's optional elements sent (see `variants`)
     conditions: tuple[tuple[int, int, Literal["little", "big"], int, int], ...] = ()  # a variant's flag bits:
     # (offset, size, byte order, mask, bits) of each flag element, which a frame must match to be read in it
+    error: bool = False  # its frames refuse their request (an error header): their code is ERROR_REPLY's
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -226,6 +227,7 @@ class Layout:
             self.codes,
             self.present | {element.name},
             (*self.conditions, (*condition, mask, mask)),
+            self.error,
         )
 
         def moved(index: int) -> int:
@@ -251,6 +253,7 @@ class Layout:
             self.codes,
             self.present,
             (*self.conditions, (*condition, mask, 0)),
+            self.error,
         )
         return (*with_it.variants, *without.variants)
 
@@ -649,8 +652,8 @@ class FrameCodec:
             return self.layouts[layout].wrap(content, code, values, request, extras)
         problem: EncodeError | None = None
         for candidate in self.layouts:
-            if candidate.codes is not None and code not in candidate.codes:
-                continue
+            if (candidate.codes is not None and code not in candidate.codes) or candidate.error:
+                continue  # (an error header's layout: only for the error reply, sent in it by its index)
             try:
                 return candidate.wrap(content, code, values, request, extras)
             except EncodeError as exc:
@@ -724,7 +727,7 @@ class FrameCodec:
                     return -1
             elif kind == "command":
                 value = int.from_bytes(data, element.endian)
-                code = ERROR_REPLY if value & self.error_flag else value
+                code = ERROR_REPLY if layout.error or value & self.error_flag else value
                 if code not in self.content_sizes or (layout.codes is not None and code not in layout.codes):
                     return -1
             elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
@@ -843,7 +846,7 @@ class FrameCodec:
                     [
                         v
                         for v in range(256)
-                        if (ERROR_REPLY if v & self.error_flag else v) in codes
+                        if (ERROR_REPLY if layout.error or v & self.error_flag else v) in codes
                         and (layout.codes is None or v in layout.codes)
                     ]
                 ]
@@ -884,6 +887,7 @@ class FrameCodec:
             if e.kind == "value"
         )
         content_sizes, size_rules, error_flag = self.content_sizes, self.size_rules, self.error_flag
+        refusing = layout.error
         codeless = layout.command is None
         if codeless and None not in content_sizes:
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
@@ -913,7 +917,7 @@ class FrameCodec:
                     if stop - first == 1
                     else int.from_bytes(buffer[start + first : start + stop], endian)
                 )
-                code = ERROR_REPLY if value & error_flag else value
+                code = ERROR_REPLY if refusing or value & error_flag else value
                 if code not in content_sizes:
                     return -1
             for first, stop, endian, minimum, maximum, also, mask, bits in values:

@@ -111,6 +111,7 @@ class TextField:
     minimum: float | None = None
     maximum: float | None = None
     letters: type[Enum] | None = None
+    label: str = ""  # in a message with its own layout (TextLayout.named): the label its value follows
 
 
 @dataclass(frozen=True)
@@ -122,6 +123,20 @@ class TextRepeat:
     fields: tuple[TextField, ...]
     count: int = 0  # fixed number of groups (0: as many as the sentence has, up to maximum)
     maximum: int = 0
+    label: str = ""  # in a message with its own layout: the label its values follow (joined by TextLayout.list)
+
+
+@dataclass(frozen=True)
+class TextLayout:
+    """A message's own text inside the frame (GRBL's status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>`):
+    `start` + code + `separator`-joined fields + `end`. With `named`, each field is its label, `named` and its
+    value, found by the label in any order (an absent label: None); a repeat's values are joined by `list`."""
+
+    start: str
+    end: str = ""
+    separator: str = ","
+    named: str = ""
+    list: str = ""
 
 
 @dataclass(frozen=True)
@@ -133,6 +148,7 @@ class TextSentence:
     name: str = ""
     #: "request" or "response": a code may name one message each way (a command and its answer)
     direction: str = "response"
+    layout: TextLayout | None = None  # its own text inside the frame, where it has one
 
     @property
     def where(self) -> str:
@@ -182,11 +198,15 @@ class TextFraming:
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
+    layouts: tuple[TextLayout, ...] = field(init=False, repr=False, compare=False)  # the messages' own, each once
+
     def __post_init__(self) -> None:
         by_code: dict[str, dict[str, TextSentence]] = {}
         for sentence in self.sentences:
             by_code.setdefault(sentence.code, {})[sentence.direction] = sentence
         object.__setattr__(self, "by_code", by_code)
+        layouts = {s.layout: None for s in self.sentences if s.layout is not None}
+        object.__setattr__(self, "layouts", tuple(layouts))
 
     def sentence(self, code: str, direction: str | None = None) -> TextSentence:
         """The message a code names, in `direction` where the code names one each way; DecodeError where there is
@@ -212,12 +232,28 @@ class TextFraming:
             raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
         body = text[len(self.start) :]
         body = self._checked(body)
+        for layout in self.layouts:
+            if body.startswith(layout.start) and body[len(layout.start) :].endswith(layout.end):
+                return self._decode_in(layout, body[len(layout.start) : len(body) - len(layout.end)], direction)
         parts = body.split(self.separator)
         address = parts[0]
         talker, code = address[: self.talker], address[self.talker :]
         sentence = self.sentence(code, direction)
         values = _decode_fields(sentence, parts[1:])
         return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
+
+    def _decode_in(self, layout: TextLayout, inner: str, direction: str | None) -> Sentence:
+        """A frame in a message's own layout (its start and end taken off)."""
+        parts = inner.split(layout.separator)
+        talker, code = parts[0][: self.talker], parts[0][self.talker :]
+        sentence = self.sentence(code, direction)
+        if sentence.layout != layout:
+            raise DecodeError(f"{sentence.where} is not sent as {layout.start}…{layout.end}")
+        if layout.named:
+            values = _decode_labelled(sentence, layout, parts[1:])
+        else:
+            values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
+        return Sentence(talker, code, values, -1, sentence.direction)
 
     def _checked(self, body: str) -> str:
         if self.checksum is None:
@@ -252,6 +288,8 @@ class TextFraming:
         unknown = set(values) - {f.name for f in sentence.fields}
         if unknown:
             raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+        if sentence.layout is not None:
+            return self.frame(_encode_in(sentence, sentence.layout, values, talker + code, self._forbidden()))
         parts = _encode_fields(sentence, values, self._forbidden())
         if sent >= 0:
             if any(parts[sent:]):
@@ -280,6 +318,64 @@ _DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)")
 _INTEGER = re.compile(r"[+-]?\d+")
 _TIME = re.compile(r"(\d\d)(\d\d)(\d\d)(?:\.(\d*))?")
 _DATE = re.compile(r"(\d\d)(\d\d)(\d\d)")
+
+
+def _split(text: str, by: str) -> list[str]:
+    return text.split(by) if by else [text]
+
+
+def _decode_labelled(sentence: TextSentence, layout: TextLayout, parts: list[str]) -> dict[str, Any]:
+    """Fields found by their labels (`label` + `named` + value), in any order; an absent one is None (a repeat: [])."""
+    items = {item.label: item for item in sentence.fields}
+    values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in sentence.fields}
+    seen: set[str] = set()
+    for part in parts:
+        label, found, text = part.partition(layout.named)
+        item = items.get(label)
+        if not found or item is None:
+            expected = ", ".join(items) or "none"
+            raise DecodeError(f"{sentence.where}: unknown label {shown(label)} (expected one of {expected})")
+        if label in seen:
+            raise DecodeError(f"{sentence.where}: label {label!r} sent twice")
+        seen.add(label)
+        if isinstance(item, TextField):
+            values[item.name] = decode_field(sentence.where, item, text)
+            continue
+        texts = _split(text, layout.list)
+        size = len(item.fields)
+        if len(texts) % size or (item.count and len(texts) != item.count * size):
+            expected = f"{item.count * size}" if item.count else f"a multiple of {size}"
+            raise DecodeError(f"{sentence.where}: {item.name} has {len(texts)} values, expected {expected}")
+        if item.maximum and len(texts) > item.maximum * size:
+            raise DecodeError(f"{sentence.where}: {item.name} has {len(texts)} values, at most {item.maximum * size}")
+        values[item.name] = [
+            {f.name: decode_field(sentence.where, f, texts[at + i]) for i, f in enumerate(item.fields)}
+            for at in range(0, len(texts), size)
+        ]
+    return values
+
+
+def _encode_in(
+    sentence: TextSentence, layout: TextLayout, values: Mapping[str, Any], address: str, forbidden: str
+) -> str:
+    """The text of a message in its own layout: start, address, fields (labelled ones only where they have a value),
+    end."""
+    forbidden += "".join({layout.start, layout.end, layout.separator, layout.named, layout.list} - {""})
+    parts = [address]
+    for item in sentence.fields:
+        value = values.get(item.name)
+        if isinstance(item, TextField):
+            text = encode_field(sentence.where, item, value, forbidden)
+            if value is not None or not layout.named:
+                parts.append(f"{item.label}{layout.named}{text}" if layout.named else text)
+            continue
+        if not value and layout.named:
+            continue  # an absent label
+        single = TextSentence(sentence.code, (item,), sentence.where)
+        texts = _encode_fields(single, {item.name: value}, forbidden)
+        joined = (layout.list or layout.separator).join(texts)
+        parts.append(f"{item.label}{layout.named}{joined}" if layout.named else joined)
+    return layout.start + layout.separator.join(parts) + layout.end
 
 
 def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:

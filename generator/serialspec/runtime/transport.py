@@ -88,6 +88,8 @@ class ErrorReplies:
         return isinstance(reply, self.response) and code is not None and getattr(reply, self.code_field) == code
 
     def describe(self, request: Message, reply: Message) -> str:
+        if not self.reason_field:  # an error reply that says no more than that (MSP's `$M!`)
+            return f"{request.COMMAND}: the device refuses it"
         reason: Any = getattr(reply, self.reason_field)
         name = f"{reason.name.lower()} ({reason.value})" if isinstance(reason, Enum) else str(reason)
         return f"{request.COMMAND}: the device refuses it: {self.reason_field} = {name}"

@@ -34,6 +34,8 @@ def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
     if not text.start:
         raise Unsupported("text frames without a start character (every line a frame)")
+    if any(m.layout is not None for m in text.messages):
+        raise Unsupported("a message's own text layout (`text:`)")
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")

@@ -60,7 +60,7 @@ def runtime_layout(layout: FrameLayout, codes: tuple[int, ...] | None = None) ->
     t = layout.transparency
     transparency = t.transform.runtime((layout.index(t.first), layout.index(t.last))) if t else None
     elements = tuple(runtime_element(layout, e) for e in layout.elements)
-    return Layout(layout.name or layout.direction.value, elements, transparency, codes)
+    return Layout(layout.name or layout.direction.value, elements, transparency, codes, error=layout.error)
 
 
 def layout_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | None:

@@ -310,6 +310,11 @@ def error_reply_text(protocol: Protocol, message: Message) -> str:
     error = protocol.error_reply
     if not message.error_reply or error is None:
         return ""
+    if not error.flag:
+        return (
+            f"sent instead of any request's reply, under the header {error.header.hex(' ')} with `{error.element}` = "
+            f"the request's code (the message holds it as `{error.element}`)"
+        )
     return (
         f"sent instead of any request's reply, with `{error.element}` = the request's code | {error.flag:#04x} "
         f"(the message holds the request's code as `{error.element}`)"

@@ -219,7 +219,8 @@ class PackageCode:
         error = self.protocol.error_reply
         if message is not None and message.error_reply and error is not None:
             element = next(e for e in layout.elements if e.name == error.element)
-            elements.append(replace(element, minimum=0, maximum=error.flag - 1, flags=None))
+            top = error.flag - 1 if error.flag else element.maximum  # an error header: any code of the element
+            elements.append(replace(element, minimum=0, maximum=top, flags=None))
         for element in elements:
             assert element.type is not None
             values.append(

@@ -329,7 +329,7 @@ def simulator_module(protocol: Protocol) -> str:
         reply = protocol.command(protocol.error_reply.command).response
         assert reply is not None
         imports.add(reply.class_name)
-        unwraps = bool(device.errors.unsupported)
+        unwraps = device.errors.unsupported is not None
         unwrap = ", unwrap=_unwrap_request" if unwraps else ""
         error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap})"
     runtime = ["CommandSpec", "DeviceSpec"]

@@ -155,6 +155,8 @@ def _descriptor(f: TextField) -> str:
             arguments.append(f"{key}={bound!r}")
     if f.letters_class:
         arguments.append(f"letters={f.letters_class}")
+    if f.label:
+        arguments.append(f"label={f.label!r}")
     return f"TextField({', '.join(arguments)})"
 
 
@@ -202,6 +204,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         "    TextCodec,",
         "    TextField,",
         "    TextFraming,",
+        *(["    TextLayout,"] if any(m.layout is not None for m in text.messages) else []),
         "    TextMessageParser,",
         "    TextRecord,",
         "    TextRepeat,",
@@ -254,13 +257,20 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         for item in message.fields:
             if isinstance(item, TextRepeat):
                 inner = ", ".join(_descriptor(f) for f in item.fields)
-                counts = f"count={item.count}, maximum={item.max_count}"
+                counts = f"count={item.count}, maximum={item.max_count}" + (
+                    f", label={item.label!r}" if item.label else ""
+                )
                 yield f"                TextRepeat({item.name!r}, ({inner},), {counts}),"
             else:
                 yield f"                {_descriptor(item)},"
         yield "            ),"
         yield f"            name={message.code!r},"
         yield f"            direction={message.direction.value!r},"
+        if message.layout is not None:
+            shown = ", ".join(
+                f"{k}={getattr(message.layout, k)!r}" for k in ("start", "end", "separator", "named", "list")
+            )
+            yield f"            layout=TextLayout({shown}),"
         yield "        ),"
     yield "    ),"
     yield ")"

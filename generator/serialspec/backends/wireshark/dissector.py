@@ -174,6 +174,8 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
+    if layout.error:  # its frames are the error reply (an error header)
+        result["error"] = True
     t = layout.transparency
     if t is not None and engine.transparency is not None:
         first, last = engine.transparency.span

@@ -19,6 +19,8 @@ def _field(f: TextField) -> dict[str, Any]:
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
     if not text.start:
         raise Unsupported("text frames without a start character (every line a frame)")
+    if any(m.layout is not None for m in text.messages):
+        raise Unsupported("a message's own text layout (`text:`)")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

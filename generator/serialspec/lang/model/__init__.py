@@ -205,6 +205,9 @@ from serialspec.lang.model.text_frames import (
     TextFrame as TextFrame,
 )
 from serialspec.lang.model.text_frames import (
+    TextLayout as TextLayout,
+)
+from serialspec.lang.model.text_frames import (
     TextMessage as TextMessage,
 )
 from serialspec.lang.model.text_frames import (

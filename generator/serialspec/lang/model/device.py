@@ -51,17 +51,18 @@ class DeviceErrors:
     """How a device refuses a request, by reason: the reply values (response field or field.bit_field -> value),
     sent in the protocol's error reply when it has one, else in the request's own response."""
 
-    out_of_space: dict[str, float] = field(default_factory=dict)
-    out_of_range: dict[str, float] = field(default_factory=dict)
-    read_only: dict[str, float] = field(default_factory=dict)
-    unsupported: dict[str, float] = field(default_factory=dict)
-    busy: dict[str, float] = field(default_factory=dict)
-    locked: dict[str, float] = field(default_factory=dict)
+    # None: not given (an empty mapping: given, the error reply without values, as MSP's `$M!` carries none)
+    out_of_space: dict[str, float] | None = None
+    out_of_range: dict[str, float] | None = None
+    read_only: dict[str, float] | None = None
+    unsupported: dict[str, float] | None = None
+    busy: dict[str, float] | None = None
+    locked: dict[str, float] | None = None
 
     def by_reason(self) -> dict[str, dict[str, float]]:
         """The reasons given, by name (the device runtime's reasons)."""
         reasons = ("out_of_space", "out_of_range", "read_only", "unsupported", "busy", "locked")
-        return {reason: getattr(self, reason) for reason in reasons if getattr(self, reason)}
+        return {reason: given for reason in reasons if (given := getattr(self, reason)) is not None}
 
 
 @frozen

@@ -95,6 +95,9 @@ class FrameLayout:
     transparency: Transparency | None = None
     checksums: tuple[Checksum, ...] = ()
     classic: bool = True
+    # a response layout whose frames refuse their request (the header's `error_value`): each is the `error_reply`
+    # message, the command element carrying the refused code
+    error: bool = False
 
     def index(self, name: str) -> int:
         return next(i for i, e in enumerate(self.elements) if e.name == name)
@@ -157,12 +160,15 @@ class Framing:
 
 @frozen
 class ErrorReply:
-    """Replies that refuse a request: its code with `flag` set in the command element, laid out as `command`'s
-    response (Modbus exception replies: function | 0x80, then an exception code)."""
+    """Replies that refuse a request: its code with `flag` set in the command element (Modbus exception replies:
+    function | 0x80, then an exception code), or its code under another header (`header`, the header element's
+    `error_value`: MSP's `$M!`, in the response layout named `layout`), laid out as `command`'s response."""
 
-    flag: int
+    flag: int  # 0: told by the header
     element: str  # the command element; the error reply's message carries the refused code under this name
     command: str  # the command whose response is the error reply
+    header: bytes = b""
+    layout: str = ""
 
 
 @frozen

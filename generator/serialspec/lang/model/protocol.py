@@ -49,5 +49,8 @@ class Protocol:
         return {c.name: c for c in self.commands}
 
     def layout(self, message: Message) -> FrameLayout:
-        """The layout a message's frames travel in (its command's `layout`, else its direction's first)."""
+        """The layout a message's frames travel in (its command's `layout`, else its direction's first; the error
+        reply's, where a header tells error replies: theirs)."""
+        if message.error_reply and self.error_reply is not None and self.error_reply.layout:
+            return self.framing.layout_of(message.direction, self.error_reply.layout)
         return self.framing.layout_of(message.direction, message.layout)

@@ -26,6 +26,7 @@ class TextField:
     maximum: float | None = None
     letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
     letters_class: str = ""  # char with letters: the generated Enum's name
+    label: str = ""  # in a message with its own text layout (`named`): the label its value follows
 
 
 @frozen
@@ -37,6 +38,19 @@ class TextRepeat:
     description: str = ""
     count: int = 0
     max_count: int = 0
+    label: str = ""  # in a message with its own text layout: the label its values follow (joined by `list`)
+
+
+@frozen
+class TextLayout:
+    """A message's own text inside the frame (`text:`): start + code + separated fields + end; with `named`, fields
+    found by their labels (label, `named`, value), a repeat's values joined by `list`."""
+
+    start: str
+    end: str = ""
+    separator: str = ","
+    named: str = ""
+    list: str = ""
 
 
 @frozen
@@ -54,6 +68,7 @@ class TextMessage:
     source: str = ""
     answered_by: str = ""  # a request answered by another command's response (its key): GRBL's `ok`
     refused_by: tuple[str, ...] = ()  # commands whose responses refuse the request instead: GRBL's `error:N`
+    layout: TextLayout | None = None  # its own text inside the frame (`text:`): GRBL's `<Idle|MPos:…>`
 
 
 @frozen

@@ -495,6 +495,8 @@ class Commands(FieldResolver):
             self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
         if value.get("error_reply") and direction != Direction.RESPONSE:
             self.error((*path, "error_reply"), "an error reply is a response")
+        if "text" in value:
+            self.error((*path, "text"), "`text` belongs to messages of text frames (`framing: {kind: text}`)")
         return Message(
             command=command,
             subcommand=subcommand,

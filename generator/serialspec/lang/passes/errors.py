@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from serialspec.lang.errors import SpecError
-from serialspec.lang.model import Direction, ErrorReply
+from serialspec.lang.model import Direction, ErrorReply, FrameLayout, Message
 from serialspec.lang.passes.base import Pass
 
 
@@ -18,11 +18,14 @@ class ErrorReplies(Pass):
         replies = [(c.name, m) for c in self.ctx.commands for m in c.messages() if m.error_reply]
         for name, _ in replies[1:]:
             self.error(("commands", name, "response", "error_reply"), f"only one error reply: {replies[0][0]!r} is one")
+        refusing = [lay for lay in framing.alternatives[Direction.RESPONSE] if lay.error] if framing else []
+        if refusing:
+            return self.by_header(refusing[0], replies)
         if not flagged:
             for name, _ in replies[:1]:
                 self.error(
                     ("commands", name, "response", "error_reply"),
-                    "an error reply needs `error_flag` on the framing's command element",
+                    "an error reply needs `error_flag` on the framing's command element or `error_value` on its header",
                 )
             return self.problems
         for name, element in flagged:
@@ -53,4 +56,21 @@ class ErrorReplies(Pass):
                     f"the error reply carries the refused code as {element_name!r} already",
                 )
             self.ctx.error_reply = ErrorReply(flag, element_name, command)
+        return self.problems
+
+    def by_header(self, layout: FrameLayout, replies: list[tuple[str, Message]]) -> list[SpecError]:
+        """Error replies told by their header (`error_value`): the `error_reply` response is their content."""
+        header = layout.elements[0].name
+        element = next(e.name for e in layout.elements if e.role == "command")
+        path = ("framing", "elements", header, "error_value")
+        if not replies:
+            self.error(path, "`error_value` needs a command whose response is marked `error_reply: true`")
+            return self.problems
+        command, message = replies[0]
+        if any(f.name == element for f in message.fields):
+            self.error(
+                ("commands", command, "response", "fields", element),
+                f"the error reply carries the refused code as {element!r} already",
+            )
+        self.ctx.error_reply = ErrorReply(0, element, command, layout.header, layout.name)
         return self.problems

@@ -39,7 +39,7 @@ FIELD_KINDS = (
 
 
 # Keys of text fields (framing kind text) that a binary field must not have
-TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count")
+TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count", "label")
 
 
 class FieldResolver(Pass):

@@ -65,6 +65,7 @@ class FramingPass(FieldResolver):
         alternatives: dict[Direction, list[FrameLayout]] = {d: [] for d in Direction}
         commands = self.section("commands")
         by_command = "layouts" in value and any(isinstance(c, dict) and "layout" in c for c in commands.values())
+        refusing: list[FrameLayout] = []  # the error replies' layouts (`error_value`), after every other
         for layout_name, (raw, elements_path) in raw_layouts.items():
             elements = [
                 (name, item, self.frame_element(name, item, (*elements_path, name))) for name, item in raw.items()
@@ -74,6 +75,8 @@ class FramingPass(FieldResolver):
                 alternatives[direction].append(
                     self.layout(direction, layout_name, elements, transparency, elements_path, path, request)
                 )
+            refusing += self.error_layout(raw, alternatives[Direction.RESPONSE][-1], elements_path, by_command)
+        alternatives[Direction.RESPONSE] += refusing
         for direction, layouts in alternatives.items():
             if len(layouts) > 1 and not by_command:
                 headers = [layout.header for layout in layouts]
@@ -107,6 +110,48 @@ class FramingPass(FieldResolver):
             gap=float(value.get("gap", 0.0)),
             by_command=by_command,
         )
+
+    def error_layout(
+        self, raw: dict[str, Any], response: FrameLayout, elements_path: Path, by_command: bool
+    ) -> list[FrameLayout]:
+        """The layout of replies that refuse their request, where the header has an `error_value`: the response
+        layout under that header (MSP: `$M!` for `$M>`)."""
+        found = [(name, item) for name, item in raw.items() if isinstance(item, dict) and "error_value" in item]
+        if not found:
+            return []
+        name, item = found[0]
+        path: Path = (*elements_path, name, "error_value")
+        if item.get("role") != "header":
+            raise self.fail(path, "`error_value` goes on the header element")
+        if not response.elements or response.elements[0].name != name:
+            raise self.fail(path, "the header with an `error_value` must be in the response frame")
+        if by_command:
+            raise self.fail(path, "an error header needs layouts told apart by their header, not chosen by command")
+        if any("error_flag" in other for other in raw.values() if isinstance(other, dict)):
+            raise self.fail(path, "give either the command element's `error_flag` or the header's `error_value`")
+        try:
+            constant = parse_hex(str(item["error_value"]))
+        except ValueError as exc:
+            raise self.fail(path, str(exc)) from None
+        if len(constant) != len(response.header):
+            raise self.fail(path, f"the error header has as many bytes as the response header ({len(response.header)})")
+        if constant == response.header:
+            raise self.fail(path, f"the error header must differ from the response header ({constant.hex(' ')})")
+        if not response.has_command:
+            raise self.fail(
+                path, "an error header needs a command element in the response: it carries the refused code"
+            )
+        header = replace(response.elements[0], constant=constant)
+        return [
+            replace(
+                response,
+                header=constant,
+                elements=(header, *response.elements[1:]),
+                name=f"{response.name}_error" if response.name else "error",
+                classic=False,
+                error=True,
+            )
+        ]
 
     def frame_element(self, name: str, item: dict[str, Any], path: Path) -> FrameElement:
         """The element as declared (both directions); `layout` makes each direction's copy."""

@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     TextExample,
     TextField,
     TextFrame,
+    TextLayout,
     TextMessage,
     TextRepeat,
     Unsolicited,
@@ -40,7 +41,7 @@ KIND_KEYS = {
     "time": {"precision"},
     "date": set(),
 }
-COMMON_KEYS = {"type", "use", "description", "unit"}
+COMMON_KEYS = {"type", "use", "description", "unit", "label"}
 BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
 TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
 NOT_YET = ("matching", "enums", "flags", "tables", "errata")
@@ -185,6 +186,15 @@ class TextPass(Pass):
                 f"{key} has a response of its own: leave out `answered_by` or the response",
             )
         fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
+        layout = (
+            self.layout(raw["text"], code, fields, (*where, "text"), framing - {frame.separator} if frame else set())
+            if "text" in raw
+            else None
+        )
+        if layout is None:
+            for item in fields:
+                if item.label:
+                    self.error((*where, "fields", item.name, "label"), "a label needs `text: {named: ...}`")
         class_name = camel(key, direction.value)
         self.class_name(class_name, where)
         return TextMessage(
@@ -199,7 +209,40 @@ class TextPass(Pass):
             source=str(raw.get("source") or command.get("source", "")),
             answered_by=str(answered_by.get("command", "")),
             refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
+            layout=layout,
         )
+
+    def layout(
+        self, raw: dict[str, Any], code: str, fields: tuple[TextField | TextRepeat, ...], path: Path, framing: set[str]
+    ) -> TextLayout:
+        """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
+        layout = TextLayout(**{k: str(raw[k]) for k in ("start", "end", "separator", "named", "list") if k in raw})
+        if not layout.start or layout.start[0] in CODE_CHARACTERS:
+            self.error((*path, "start"), "a message's text starts with a character no text code has (GRBL: `<`)")
+        for key in ("separator", "named", "list"):
+            value = getattr(layout, key)
+            if key in raw and len(value) != 1:
+                self.error((*path, key), f"`{key}` is one character")
+        single = [c for c in (layout.separator, layout.named, layout.list) if c]
+        if len(set(single)) != len(single) or set(single) & framing:
+            self.error(path, "`separator`, `named` and `list` differ from each other and from the framing's characters")
+        if set(code) & set(single):
+            self.error(path, f"the code {code!r} holds one of the message's own characters")
+        for item in fields:
+            where = (*path[:-1], "fields", item.name)
+            if layout.named and not item.label:
+                self.error(where, "with `text.named` every field needs a `label`")
+            if isinstance(item, TextRepeat) and not layout.list:
+                self.error(where, "a repeat in a message's own text needs `text.list` between its values")
+            if isinstance(item, TextRepeat) and any(f.label for f in item.fields):
+                self.error(where, "a label goes on the repeat, not on its fields")
+        labels = [item.label for item in fields if item.label]
+        if len(set(labels)) != len(labels):
+            self.error((*path[:-1], "fields"), "two fields share a label")
+        for label in labels:
+            if set(label) & set(single) or not label.isprintable() or " " in label:
+                self.error((*path[:-1], "fields"), f"label {label!r} holds a character the message's text uses")
+        return layout
 
     def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:
         found: list[TextField | TextRepeat] = []
@@ -236,7 +279,14 @@ class TextPass(Pass):
             if bool(count) == bool(most):
                 raise self.fail(path, "a repeat needs `count` (always sent) or `max_count` (at the end), not both")
             inner = self.fields(spec.get("fields") or {}, (*path, "fields"), top=False)
-            return TextRepeat(name, cast(tuple[TextField, ...], inner), str(spec.get("description", "")), count, most)
+            return TextRepeat(
+                name,
+                cast(tuple[TextField, ...], inner),
+                str(spec.get("description", "")),
+                count,
+                most,
+                label=str(spec.get("label", "")),
+            )
         if kind not in KINDS:
             raise self.fail(path, f"unknown text field type {kind!r} (expected one of {', '.join(KINDS)}, repeat)")
         for key in spec:
@@ -264,6 +314,7 @@ class TextPass(Pass):
             maximum=high,
             letters=letters,
             letters_class=letters_class,
+            label=str(spec.get("label", "")),
         )
 
     def device(self, raw: dict[str, Any], frame: TextFrame) -> TextDevice:

@@ -776,7 +776,8 @@ class Engine(FaultInjection):
 
     def _unsupported(self, data: bytes) -> list[tuple[float, bytes]]:
         """Bytes that arrived together and that the parser took for no frame: if they are one whole request whose
-        checksum verifies but whose code no command has, the addressed device refuses it (Modbus exception 1)."""
+        checksum verifies but whose code no command has, the addressed device refuses it (Modbus exception 1; MSP's
+        `$M!`)."""
         error = self.spec.error
         if error is None or "unsupported" not in self.spec.errors or error.unwrap is None:
             return []
@@ -787,7 +788,10 @@ class Engine(FaultInjection):
         known = {c.code for c in self.spec.commands}
         if code is None or code in known:
             return []
-        device = self.devices.get(values[0]) if self.spec.address and values else None
+        if self.spec.address:
+            device = self.devices.get(values[0]) if values else None
+        else:  # frames without an address: the one device on the line answers (MSP's flight controller)
+            device = next(iter(self.devices.values()), None)
         if device is None:
             return []  # another device's, or broadcast: no reply
         refusal = CommandSpec(error.response, None, code=code)

@@ -69,6 +69,7 @@ def direction_functions(
             f"    return _decode_{d}_engine(frame, expect)",
         ]
     wraps: list[LayoutEncoding] = []
+    refusals: list[LayoutEncoding] = []  # the error header's layouts: only the error reply is sent in them
     bodies: list[Lines] = []
     for layout, checks, algorithms in zip(layouts, found.checks, found.algorithms, strict=True):
         suffix = f"_{layout.name}" if several else ""
@@ -82,7 +83,7 @@ def direction_functions(
         function = [*function[:2], *(f"    {line}" for line in divert), *function[2:]]
         lines += [*function, "", ""]
         bodies.append(body)
-        wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))
+        (refusals if layout.error else wraps).append(wrap_parts(layout, target, checks, stuffing, registry(structs)))
     if several:
         choice = choice_lines(layouts, d)
         lines += [
@@ -102,6 +103,7 @@ def direction_functions(
     ]
     lines += [*table, "", ""] if table else []
     lines += wrap_lines(d, wraps, target)
+    lines += ["", "", *wrap_lines(f"{d}_error", refusals, target)] if refusals else []
     return lines, call
 
 
@@ -136,10 +138,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
             assert element.type is not None
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
-            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
+            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag, refusing=not flag)
         plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
-        names |= {ERROR_REPLY} if frames.error_flag else set()
+        names |= {ERROR_REPLY} if frames.error_flag or frames.refusing else set()
         if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
             answering = [m for m in protocol.messages() if m.direction == direction]
             sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]

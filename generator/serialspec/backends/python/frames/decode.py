@@ -145,9 +145,11 @@ def decode_lines(
     if command is not None:
         body.append(f"code = {positions.read(command)}")
     code = "None" if command is None else "code"
-    body += dispatch_lines(
-        target, code, ", ".join([positions.buf, str(positions.content), "end", *values]), nullable=False
-    )
+    arguments = ", ".join([positions.buf, str(positions.content), "end", *values])
+    if layout.error and command is not None:  # an error header: the error reply, refusing the request of `code`
+        body.append(f"return _{target.upper}_DECODERS[ERROR_REPLY]({arguments}, code)")
+    else:
+        body += dispatch_lines(target, code, arguments, nullable=False)
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
@@ -308,7 +310,15 @@ def _engine_decode(decode: Lines, target: Target) -> Lines:
     """The engine's decode function, its content dispatched by code (and by the expected class)."""
     arguments = "content, 0, len(content), *unwrapped.values"
     arguments += "".join(f", unwrapped.extras.get({name!r})" for name in target.optional)
-    return [*decode, *(f"    {line}" for line in dispatch_lines(target, "code", arguments, nullable=True))]
+    refusing = (
+        [
+            "    if unwrapped.layout.error:  # an error header: the error reply, refusing the request of `code`",
+            f"        return _{target.upper}_DECODERS[ERROR_REPLY]({arguments}, code)",
+        ]
+        if target.refusing
+        else []
+    )
+    return [*decode, *refusing, *(f"    {line}" for line in dispatch_lines(target, "code", arguments, nullable=True))]
 
 
 def choice_lines(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = None) -> Lines:

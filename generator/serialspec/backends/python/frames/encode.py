@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol as Interface
 
 from serialspec.backends.common.frames import layout_index, optional_elements
@@ -422,8 +422,17 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             content, parts = "content", ["content"]
         code: str = Simple(f"{command_code:#04x}" if command_code is not None and layout.has_command else "None")
         if error is not None:
-            code = f"{field_read('m', error.element)} | {error.flag:#04x}"
+            code = field_read("m", error.element) + (f" | {error.flag:#04x}" if error.flag else "")
         frames = package.straight(message.direction)
+        refusing = error is not None and not error.flag  # under the error header: its layouts alone
+        if frames:
+            kept = [i for i, layout in enumerate(frames.layouts) if layout.error == refusing]
+            frames = replace(
+                frames,
+                layouts=tuple(frames.layouts[i] for i in kept),
+                checks=tuple(frames.checks[i] for i in kept),
+                algorithms=tuple(frames.algorithms[i] for i in kept),
+            )
         size = message.min_size if message.min_size == message.max_size and message.padded is None else None
         name = f"frame_{message.class_name}"
         inline = frames and frame_encoder(
@@ -444,6 +453,15 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
         body += guard
         arguments = ", ".join([content, code, *frame_values])
         framing = package.protocol.framing
+        if refusing and frames:  # the error header's wrap
+            body.append(Code(f"return _wrap_response_error({arguments})", lists=packed_lists(parts)))
+            return body
+        if refusing:  # the engine's, in the error header's layout
+            values = f"({', '.join(frame_values)},)" if frame_values else "()"
+            index = layout_index(package.protocol, message)
+            wrap = f"return _RESPONSE_FRAMES.wrap({content}, {code}, {values}, {index})"
+            body.append(Code(wrap, lists=packed_lists(parts)))
+            return body
         if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
             arguments += f", {layout_index(package.protocol, message)}, request"
         arguments += extras

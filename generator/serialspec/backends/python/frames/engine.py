@@ -101,7 +101,7 @@ def layout_lines(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> l
     lines = [f"Layout({(layout.name or layout.direction.value)!r}, ("]
     lines += [f"    {element_expr(layout, e)}," for e in layout.elements]
     shown = ", ".join(f"{c:#04x}" for c in codes or ()) + ("," if codes is not None and len(codes) == 1 else "")
-    end = f"), codes=({shown}))," if codes is not None else ")),"
+    end = f"), codes=({shown}))," if codes is not None else "), error=True)," if layout.error else ")),"
     if layout.transparency is None:
         lines.append(end)
         return lines
@@ -157,7 +157,7 @@ def codec_lines(
         codes += [code for code, _ in rules]
     names |= {ERROR_REPLY} if ERROR_REPLY in codes else set()
     error = protocol.error_reply
-    if error is not None and direction == Direction.RESPONSE:
+    if error is not None and direction == Direction.RESPONSE and error.flag:
         lines.append(f"    error_flag={error.flag:#04x},")
     if protocol.framing.by_request(direction):  # each reply class's layout: read with the request's reply class
         lines.append("    replies={")

@@ -52,6 +52,7 @@ class Target:
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
     requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
     optional: tuple[str, ...] = ()  # the optional elements (`present_if`) the messages carry: the engine's
+    refusing: bool = False  # some layout's frames are error replies (an error header): the engine's code asks
 
 
 def straight(layout: Layout) -> bool:

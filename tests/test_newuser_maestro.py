@@ -156,7 +156,7 @@ commands:
     strict=True,
     reason="language gap: the Pololu protocol form sends the same commands after 0xAA and a device number with bit 7 "
     "of the command cleared (AA 0C 04 02 70 2E for 84 02 70 2E); the spec needs a command element whose wire value "
-    "is an expression of the command's code in one layout (`code: \"code & 0x7F\"`, as `reply_code` is for replies); "
+    'is an expression of the command\'s code in one layout (`code: "code & 0x7F"`, as `reply_code` is for replies); '
     "the loader refuses the key, so a spec can give one form only",
 )
 def test_the_pololu_protocol_form(tmp_path: Path) -> None:

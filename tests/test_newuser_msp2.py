@@ -11,6 +11,7 @@ import os
 import struct
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import pytest
 from conftest import generate_and_import
@@ -46,7 +47,7 @@ class Port:
         return chunk
 
 
-def board(port: object) -> object:
+def board(port: object) -> Any:
     """An MSPy on `port`, as an iNAV board, without `with` (which opens the port and asks v1 commands)."""
     peer = yamspy.MSPy("unused", logfilename=os.devnull, loglevel="WARNING")  # opens nothing until `with`
     peer.conn, peer.INAV = port, True
@@ -56,7 +57,7 @@ def board(port: object) -> object:
 def test_requests_match_yamspy(m2: ModuleType) -> None:
     for code, message in [(ANALOG, m2.InavAnalogRequest()), (DEBUG, m2.InavDebugRequest())]:
         port = Port()
-        board(port).send_RAW_msg(code, data=[])  # type: ignore[attr-defined]
+        board(port).send_RAW_msg(code, data=[])
         assert m2.encode(message) == port.written
         assert m2.decode(port.written, m2.Direction.REQUEST) == message
 
@@ -89,11 +90,11 @@ def test_yamspy_reads_our_analog_replies(
     frame = m2.encode(message)
     assert m2.decode(frame, m2.Direction.RESPONSE) == message
     peer = board(Port(frame))
-    handler = peer.receive_msg()  # type: ignore[attr-defined]
+    handler = peer.receive_msg()
     assert not handler["crcError"] and not handler["packet_error"]
     assert handler["code"] == ANALOG
-    assert peer.process_recv_data(handler) == 0  # type: ignore[attr-defined]  # (the payload bytes it left over)
-    analog = peer.ANALOG  # type: ignore[attr-defined]
+    assert peer.process_recv_data(handler) == 0  # (the payload bytes it left over)
+    analog = peer.ANALOG
     assert (analog["cell_count"], analog["battery_state"], analog["battery_full_when_plugged_in"]) == (cells, 2, True)
     assert (analog["voltage"], analog["amperage"], analog["power"]) == (voltage / 100, amperage / 100, power / 100)
     assert (analog["mAhdrawn"], analog["battery_percentage"], analog["rssi"]) == (mah, percentage, rssi)
@@ -104,7 +105,7 @@ def test_a_reply_with_a_wrong_crc_is_refused_by_both(m2: ModuleType) -> None:
     frame[-1] ^= 0x01
     with pytest.raises(DecodeError):
         m2.decode(bytes(frame), m2.Direction.RESPONSE)
-    assert board(Port(bytes(frame))).receive_msg()["crcError"]  # type: ignore[attr-defined]
+    assert board(Port(bytes(frame))).receive_msg()["crcError"]
 
 
 def test_yamspy_asks_the_sim() -> None:
@@ -113,12 +114,17 @@ def test_yamspy_asks_the_sim() -> None:
     with serve(str(SPEC)) as path, serial.Serial(path, 115200, timeout=2) as port:
         peer = board(port)
         for code in (ANALOG, DEBUG):
-            peer.send_RAW_msg(code, data=[])  # type: ignore[attr-defined]
+            peer.send_RAW_msg(code, data=[])
             # yamspy reads one byte past a v2 frame (size + 2 for a 1-byte CRC): the port's timeout ends that read
-            assert peer.process_recv_data(peer.receive_msg()) == 0  # type: ignore[attr-defined]
-    analog = peer.ANALOG  # type: ignore[attr-defined]
-    assert (analog["voltage"], analog["cell_count"], analog["battery_percentage"], analog["rssi"]) == (16.8, 4, 93, 1000)
-    assert peer.SENSOR_DATA["debug"] == [1, -2, 3, -4, 5, -6, 7, -8]  # type: ignore[attr-defined]
+            assert peer.process_recv_data(peer.receive_msg()) == 0
+    analog = peer.ANALOG
+    assert (analog["voltage"], analog["cell_count"], analog["battery_percentage"], analog["rssi"]) == (
+        16.8,
+        4,
+        93,
+        1000,
+    )
+    assert peer.SENSOR_DATA["debug"] == [1, -2, 3, -4, 5, -6, 7, -8]
 
 
 def test_the_generated_client_asks_the_sim(m2: ModuleType) -> None:

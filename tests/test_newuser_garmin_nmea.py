@@ -12,7 +12,7 @@ from types import ModuleType
 from typing import Any
 
 import pytest
-from conftest import generate_and_import
+from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from sim_process import serve
@@ -41,7 +41,7 @@ def test_garmins_example(gn: ModuleType) -> None:
     assert gn.encode(ours).decode().rstrip("\r\n") == GARMIN_EXAMPLE
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(hpe=tenths(), vpe=tenths(), osepe=tenths())
 def test_position_errors_match_pynmea2(gn: ModuleType, hpe: str, vpe: str, osepe: str) -> None:
     golden = grm.GRME("GRM", ["E", hpe, "M", vpe, "M", osepe, "M"]).render()
@@ -59,7 +59,7 @@ def test_position_errors_match_pynmea2(gn: ModuleType, hpe: str, vpe: str, osepe
     assert pynmea2.parse(gn.encode(built).decode(), check=True).render() == golden
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(altitude=st.integers(-1500, 60000), dimension=st.sampled_from([2, 3]))
 def test_altitudes_match_pynmea2(gn: ModuleType, altitude: int, dimension: int) -> None:
     golden = grm.GRMZ("GRM", ["Z", str(altitude), "f", str(dimension)]).render()

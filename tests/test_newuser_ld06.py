@@ -12,7 +12,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import generate_and_import
+from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError
@@ -43,7 +43,7 @@ def test_the_crc_is_the_peers_table() -> None:
     assert crc8(b"123456789") == 0xC3
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(
     speed=st.integers(0, 65535),
     start=st.integers(0, 35999),

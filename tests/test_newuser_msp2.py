@@ -14,7 +14,7 @@ from types import ModuleType
 from typing import Any
 
 import pytest
-from conftest import generate_and_import
+from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError
@@ -62,7 +62,7 @@ def test_requests_match_yamspy(m2: ModuleType) -> None:
         assert m2.decode(port.written, m2.Direction.REQUEST) == message
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(
     cells=st.integers(0, 15),
     voltage=st.integers(0, 65535),

@@ -12,7 +12,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import generate_and_import
+from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError
@@ -41,7 +41,7 @@ def peer_unpack(frame: bytes) -> tuple[list[int], int]:
     return [sum(bits[11 * i + b] << b for b in range(11)) for i in range(16)], frame[23]
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(channels=st.lists(st.integers(0, 2047), min_size=16, max_size=16), flags=st.integers(0, 15))
 def test_frames_match_the_bit_packer(sb: ModuleType, channels: list[int], flags: int) -> None:
     golden = peer_pack(channels, flags)

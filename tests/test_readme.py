@@ -59,3 +59,20 @@ def test_the_readme_names_the_errors_decode_and_encode_raise() -> None:
         fs.decode(bytes(frame))
     with pytest.raises(names["RangeError"]):  # type: ignore[call-overload]
         fs.encode(fs.RotateRequest(servo_id=2, angle=900, interval=500, power=-1))
+
+
+def test_the_readme_crc_table_recipe_gives_the_catalogue_parameters() -> None:
+    """Found by a new user (tests/test_newuser_ld06.py): the LDROBOT datasheet prints a CRC-8 table and a loop, the
+    `crc:` key wants catalogue parameters and a check value, and the docs did not say how to get one from the other.
+    The README's recipe, run on the table lds2d ships, gives what tests/specs/ld06.yaml says."""
+    import yaml
+
+    crc_module = pytest.importorskip("lds2d.crc")
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    recipe = re.search(r"```python\n(table = CRC_TABLE.*?)```", text, re.S)
+    assert recipe, "the README has no CRC table recipe"
+    names: dict[str, object] = {"CRC_TABLE": crc_module.CRC_TABLE}
+    exec(compile(recipe.group(1), "README.md", "exec"), names)
+    spec = yaml.safe_load((ROOT / "tests" / "specs" / "ld06.yaml").read_text(encoding="utf-8"))
+    crc = spec["framing"]["elements"]["crc"]["crc"]
+    assert (names["poly"], names["check"]) == (crc["poly"], crc["check"]) == (0x4D, 0xC3)

@@ -2412,7 +2412,10 @@ static void crsf__drop(crsf_parser_t *p, size_t cut)
 
 #if CRSF_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for crsf_parser_push's
- * CRSF_EVENT_FRAME_UNKNOWN. */
+ * CRSF_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void crsf__keep_unknown(crsf_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

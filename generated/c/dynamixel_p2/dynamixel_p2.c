@@ -2098,7 +2098,10 @@ static void dynamixel_p2__drop(dynamixel_p2_parser_t *p, size_t cut)
 
 #if DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for dynamixel_p2_parser_push's
- * DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN. */
+ * DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void dynamixel_p2__keep_unknown(dynamixel_p2_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

@@ -2804,7 +2804,10 @@ static void mavlink_common__drop(mavlink_common_parser_t *p, size_t cut)
 
 #if MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for mavlink_common_parser_push's
- * MAVLINK_COMMON_EVENT_FRAME_UNKNOWN. */
+ * MAVLINK_COMMON_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void mavlink_common__keep_unknown(mavlink_common_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

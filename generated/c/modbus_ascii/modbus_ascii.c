@@ -2668,7 +2668,10 @@ static void modbus_ascii__drop(modbus_ascii_parser_t *p, size_t cut)
 
 #if MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for modbus_ascii_parser_push's
- * MODBUS_ASCII_EVENT_FRAME_UNKNOWN. */
+ * MODBUS_ASCII_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void modbus_ascii__keep_unknown(modbus_ascii_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

@@ -2693,7 +2693,10 @@ static void modbus_rtu__drop(modbus_rtu_parser_t *p, size_t cut)
 
 #if MODBUS_RTU_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for modbus_rtu_parser_push's
- * MODBUS_RTU_EVENT_FRAME_UNKNOWN. */
+ * MODBUS_RTU_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void modbus_rtu__keep_unknown(modbus_rtu_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

@@ -2406,7 +2406,10 @@ static void ubx__drop(ubx_parser_t *p, size_t cut)
 
 #if UBX_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for ubx_parser_push's
- * UBX_EVENT_FRAME_UNKNOWN. */
+ * UBX_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void ubx__keep_unknown(ubx_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

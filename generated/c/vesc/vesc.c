@@ -2380,7 +2380,10 @@ static void vesc__drop(vesc_parser_t *p, size_t cut)
 
 #if VESC_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for vesc_parser_push's
- * VESC_EVENT_FRAME_UNKNOWN. */
+ * VESC_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void vesc__keep_unknown(vesc_parser_t *p, size_t pos, size_t size)
 {
     size_t i;

@@ -1370,7 +1370,10 @@ static void {p}__drop({p}_parser_t *p, size_t cut)
 
 #if {P}_PARSER_UNKNOWN_FRAMES
 /* A frame of an unknown command copied out of the bytes held (they move), for {p}_parser_push's
- * {P}_EVENT_FRAME_UNKNOWN. */
+ * {P}_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void {p}__keep_unknown({p}_parser_t *p, size_t pos, size_t size)
 {{
     size_t i;

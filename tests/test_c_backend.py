@@ -274,7 +274,7 @@ class Driver:
             answer = self.process.stdout.readline()
             assert answer, f"the driver stopped (sanitizer report above?) on: {line}"
             answers.append(answer.rstrip("\n"))
-            if not line.startswith("stream") or answer.startswith("end "):
+            if not line.startswith(("stream", "push")) or answer.startswith("end "):
                 return answers
 
 
@@ -582,6 +582,127 @@ def test_a_frame_of_an_unknown_command_with_a_good_checksum_is_counted_as_python
         assert counters == (frames, garbage, errors, 0), name
         for sizes in ("1", "3", "64"):
             stream_agrees_with_python(driver(name), g, Direction.REQUEST, stream, sizes)
+
+
+def _frame_codec(g: Generated, direction: Direction) -> Any:
+    """The Python codec's FrameCodec of a direction (general framing), or None (classic length-byte frames)."""
+    return getattr(getattr(g.package, "codec", None), f"_{direction.name}_FRAMES", None)
+
+
+# where a frame's size comes from its length field alone: a frame of an unknown command is a candidate the parser
+# judges, and parser_push reports it (FEETECH's and the other length-byte frames trust a length only with a command)
+UNKNOWN_SPECS = [g for g in C_SPECS if _frame_codec(g, Direction.REQUEST) is not None]
+
+
+def unknown_frames(g: Generated, direction: Direction) -> st.SearchStrategy[bytes]:
+    """Valid frames sent again with a command code the spec does not have (the frame, its length and checksum built
+    by the Python codec): each has a good checksum and an unknown command."""
+    codec = _frame_codec(g, direction)
+    codes = {c.code for c in g.protocol.commands}
+    unused = next(code for code in range(1, 0x80) if code not in codes)
+
+    def rewrap(frame: bytes) -> bytes:
+        unwrapped = codec.unwrap(frame)
+        return bytes(codec.wrap(unwrapped.content, unused, unwrapped.values))
+
+    return frames_of(g, direction).map(rewrap)
+
+
+def _coded(g: Generated, direction: Direction) -> bool:
+    """The direction's frames carry a command code (DYNAMIXEL's status packets carry a constant instead)."""
+    return all(layout.command is not None for layout in _frame_codec(g, direction).layouts)
+
+
+def judged(g: Generated, direction: Direction, frame: bytes) -> bool:
+    """The Python parser judges this frame of an unknown command a corrupt candidate (an error), as where a frame's
+    size comes from its length field alone; where the command's content bounds size it, it is no candidate."""
+    parser = g.package.StreamParser(direction.value)
+    parser.feed(frame)
+    return parser.errors == 1
+
+
+def pushed(run: Driver, direction: Direction, stream: bytes) -> tuple[list[Any], list[bytes], tuple[int, ...], int]:
+    """The stream through parser_push byte by byte: the messages, the FRAME_UNKNOWN events' frames, the counters
+    (frames, garbage, errors, bytes held) and the `unknown` counter."""
+    answers = run.ask(f"push {direction.value} {stream.hex() or '-'}")
+    messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
+    unknown = [bytes.fromhex(a[8:]) for a in answers if a.startswith("unknown ")]
+    *counters, count = (int(x) for x in answers[-1].split()[1:])
+    return messages, unknown, tuple(counters), count
+
+
+@pytest.mark.parametrize("g", UNKNOWN_SPECS, ids=[g.protocol.name for g in UNKNOWN_SPECS])
+def test_parser_push_reports_a_frame_of_an_unknown_command_and_otherwise_gives_what_python_gives(g: Generated) -> None:
+    """p_parser_push on noisy streams holding frames of unknown commands: the messages and counters of the Python
+    parser (the unknown frame stays a corrupt candidate to both), and an event for each frame of an unknown command
+    it judges, whose bytes the Python codec refuses as "unknown command"; where such frames come between valid ones
+    each is reported once, in order."""
+    directions = [d for d in g.protocol.framing.layouts if _frame_codec(g, d) is not None and _coded(g, d)]
+    # without a header every byte starts a candidate (Modbus RTU): which ones an unknown frame's bytes give is the
+    # noisy property's alone
+    headed = all(layout.header for d in directions for layout in _frame_codec(g, d).layouts)
+    run = driver(g.protocol.name)
+
+    def noisy(d: Direction) -> st.SearchStrategy[tuple[Direction, bytes]]:
+        piece = st.one_of(unknown_frames(g, d), noisy_stream(g, d))
+        return st.tuples(st.just(d), st.lists(piece, max_size=4).map(b"".join))
+
+    def clean(d: Direction) -> st.SearchStrategy[tuple[Direction, list[bytes], list[bytes]]]:
+        piece = st.one_of(unknown_frames(g, d).map(lambda f: (f, True)), frames_of(g, d).map(lambda f: (f, False)))
+        return st.lists(piece, max_size=5).map(lambda ps: (d, [f for f, _ in ps], [f for f, u in ps if u]))
+
+    @settings(max_examples=examples(10), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.sampled_from(directions).flatmap(noisy))
+    def agree(case: tuple[Direction, bytes]) -> None:
+        direction, stream = case
+        messages, unknown, counters, count = pushed(run, direction, stream)
+        assert (messages, counters) == python_stream(g, direction, stream)
+        assert count >= len(unknown)
+        for frame in unknown:
+            assert frame in stream
+            with pytest.raises(DecodeError, match="unknown command"):
+                g.package.decode(frame, direction.value)
+
+    @settings(max_examples=examples(10), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.sampled_from(directions).flatmap(clean))
+    def each_once(case: tuple[Direction, list[bytes], list[bytes]]) -> None:
+        direction, frames, injected = case
+        stream = b"".join(frames)
+        messages, unknown, counters, count = pushed(run, direction, stream)
+        assert (messages, counters) == python_stream(g, direction, stream)
+        expected = [f for f in injected if judged(g, direction, f)]
+        assert unknown == expected and count == len(expected)
+
+    agree()
+    if headed:
+        each_once()
+
+
+def test_without_unknown_frames_the_parser_counts_them_and_reports_none(tmp_path: Path) -> None:
+    """P_PARSER_UNKNOWN_FRAMES=0 leaves the event and the frame's copy out: the frame is still counted."""
+    (g,) = [g for g in C_SPECS if g.protocol.name == "dynamixel_p2"]
+    run = Driver(
+        "dynamixel_p2", GENERATED_C / "dynamixel_p2", tmp_path, defines=("-DDYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES=0",)
+    )
+    try:
+        stream = bytes.fromhex("fffffd000103007f1d4ffffffd0001030001194e")
+        messages, unknown, counters, count = pushed(run, Direction.REQUEST, stream)
+        assert (messages, counters) == python_stream(g, Direction.REQUEST, stream)
+        assert (unknown, count) == ([], 1)
+        messages, unknown, counters, count = pushed(driver("dynamixel_p2"), Direction.REQUEST, stream)
+        assert (unknown, count) == ([bytes.fromhex("fffffd000103007f1d4f")], 1)
+    finally:
+        run.close()
+
+
+def test_parser_push_on_length_byte_frames_gives_what_feed_gives() -> None:
+    """FEETECH (length-byte frames): parser_push gives the messages and counters of the Python parser, and no
+    event for a frame of an unknown command (its length is trusted only with a known command, as in Python)."""
+    (g,) = [g for g in C_SPECS if g.protocol.name == "feetech_sms"]
+    stream = bytes.fromhex("ffff010255a7ffff010201fb00ffffff010201fb")
+    messages, unknown, counters, count = pushed(driver("feetech_sms"), Direction.REQUEST, stream)
+    assert (messages, counters) == python_stream(g, Direction.REQUEST, stream)
+    assert (len(messages), unknown, count) == (2, [], 0)
 
 
 @pytest.mark.parametrize("name", ["feetech_sms", "dynamixel_p2"])

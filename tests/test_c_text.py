@@ -343,3 +343,26 @@ def _xor(data: bytes) -> int:
     for byte in data:
         value ^= byte
     return value
+
+
+def test_parser_push_reports_a_sentence_of_an_unknown_code_with_a_good_checksum() -> None:
+    """p_parser_push: a sentence whose checksum is good but whose code the spec does not have is dropped as the
+    Python parser drops it (an error), reported as P_EVENT_FRAME_UNKNOWN with its bytes and counted in `unknown`; a
+    bad checksum is no such event; the messages are the Python parser's."""
+    b = built("nmea0183")
+
+    def sentence(body: str, good: bool = True) -> bytes:
+        check = 0
+        for c in body.encode():
+            check ^= c
+        return f"${body}*{check ^ (0 if good else 1):02X}\r\n".encode()
+
+    unknown = sentence("GPZZZ,1,2")
+    gga = b"$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n"
+    stream = unknown + gga + sentence("GPZZZ,3", good=False) + gga
+    answers = driver("nmea0183").ask(f"push response {stream.hex()}")
+    messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
+    events = [bytes.fromhex(a[8:]) for a in answers if a.startswith("unknown ")]
+    *counters, count = (int(x) for x in answers[-1].split()[1:])
+    assert (messages, tuple(counters)) == python_stream(b, "response", stream)
+    assert (len(messages), events, count) == (2, [unknown], 1)

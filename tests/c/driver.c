@@ -132,6 +132,27 @@ int main(void)
                     printf("\n");
                 }
             }
+        } else if (strcmp(cmd, "push") == 0) { /* byte by byte through parser_push: every event */
+            char *hex = strtok(NULL, " \n");
+            size_t n = unhex(hex ? hex : "", frame, sizeof(frame)), at;
+            P(parser_init)(&parser, dir);
+            for (at = 0u; at < n; at++) {
+                P(event_t) ev = P(parser_push)(&parser, frame[at], &msg);
+                size_t flen;
+                const uint8_t *f = P(parser_frame)(&parser, &flen);
+                if (ev == CAT(PROTO_UPPER, _EVENT_MESSAGE)) {
+                    P(to_json)(&msg, json, sizeof(json));
+                    printf("msg %s\nframe ", json);
+                    puthex(f, flen);
+                    printf("\n");
+                } else if (ev == CAT(PROTO_UPPER, _EVENT_FRAME_UNKNOWN)) {
+                    printf("unknown ");
+                    puthex(f, flen);
+                    printf("\n");
+                }
+            }
+            printf("end %lu %lu %lu %lu %lu\n", (unsigned long)parser.frames, (unsigned long)parser.garbage,
+                   (unsigned long)parser.errors, (unsigned long)parser.n, (unsigned long)parser.unknown);
         } else if (strcmp(cmd, "stream") == 0) {
             char *sizes = strtok(NULL, " \n");
             char *hex = strtok(NULL, " \n");

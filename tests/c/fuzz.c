@@ -75,6 +75,23 @@ static void check_stream(const uint8_t *data, size_t size, P(direction_t) dir, u
         whole.errors != pieces.errors || whole.n != pieces.n) {
         fail("pieces and one call disagree");
     }
+    P(parser_init)(&pieces, dir); /* byte by byte through parser_push: the same messages and counters */
+    got_pieces = 0u;
+    for (at = 0u; at < size; at++) {
+        P(event_t) ev = P(parser_push)(&pieces, data[at], &msg);
+        got_pieces += ev == PU(EVENT_MESSAGE) ? 1u : 0u;
+        if (ev == PU(EVENT_FRAME_UNKNOWN)) {
+            size_t len;
+            const uint8_t *f = P(parser_frame)(&pieces, &len);
+            if (f == NULL || len == 0u || P(decode)(f, len, dir, &msg) != PU(E_UNKNOWN)) {
+                fail("a frame reported as of an unknown command is not one");
+            }
+        }
+    }
+    if (got_whole != got_pieces || whole.frames != pieces.frames || whole.garbage != pieces.garbage ||
+        whole.errors != pieces.errors || whole.n != pieces.n || whole.unknown != pieces.unknown) {
+        fail("parser_push and parser_feed disagree");
+    }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

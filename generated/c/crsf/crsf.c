@@ -2307,6 +2307,7 @@ int crsf_encode(const crsf_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 #define CRSF__V_WAIT 3
 #define CRSF__V_NONE 1
 #define CRSF__V_CORRUPT 2
+#define CRSF__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void crsf_parser_init(crsf_parser_t *parser, crsf_direction_t dir)
 {
@@ -2315,11 +2316,13 @@ void crsf_parser_init(crsf_parser_t *parser, crsf_direction_t dir)
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size)
 {
     uint8_t count = crsf__count(CRSF__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2338,7 +2341,12 @@ static int crsf__try(crsf_parser_t *p, size_t pos, crsf_msg_t *out, size_t *size
             }
             continue;
         }
-        if (crsf_decode_expect(p->buf + pos, (size_t)s, CRSF__RX(p->dir), p->expect, out) != CRSF_OK) {
+        r = crsf_decode_expect(p->buf + pos, (size_t)s, CRSF__RX(p->dir), p->expect, out);
+        if (r == CRSF_E_UNKNOWN) {
+            *size = (size_t)s;
+            return CRSF__V_UNKNOWN;
+        }
+        if (r != CRSF_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = CRSF__V_CORRUPT;
             }
@@ -2402,6 +2410,22 @@ static void crsf__drop(crsf_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if CRSF_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for crsf_parser_push's
+ * CRSF_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void crsf__keep_unknown(crsf_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if CRSF__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int crsf__ends_header(const crsf_parser_t *p)
@@ -2424,7 +2448,7 @@ static int crsf__ends_header(const crsf_parser_t *p)
 static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= CRSF_MAX_FRAME) { /* only a candidate longer than CRSF_MAX_FRAME can fill it: drop its first byte */
         crsf__drop(p, 1u);
         p->garbage++;
@@ -2453,9 +2477,18 @@ static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == CRSF__V_CORRUPT) {
+        } else if (r == CRSF__V_CORRUPT || r == CRSF__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == CRSF__V_UNKNOWN) {
+                    p->unknown++;
+#if CRSF_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        crsf__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2490,7 +2523,7 @@ static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
     if (cut > 0u) {
         crsf__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if CRSF__HEADERS && CRSF_PARSER_WHOLE_FRAMES
@@ -2548,7 +2581,7 @@ size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, 
             }
         }
 #endif
-        if (crsf__push(parser, data[i], out)) {
+        if (crsf__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2561,6 +2594,27 @@ void crsf_parser_gap(crsf_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+crsf_event_t crsf_parser_push(crsf_parser_t *parser, uint8_t byte, crsf_msg_t *out)
+{
+#if CRSF_ROLE != CRSF_ROLE_BOTH
+    if (!CRSF__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return CRSF_EVENT_NONE;
+    }
+#endif
+    switch (crsf__push(parser, byte, out)) {
+    case 1:
+        return CRSF_EVENT_MESSAGE;
+    case 2:
+#if CRSF_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return CRSF_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return CRSF_EVENT_NONE;
+    }
 }
 
 const uint8_t *crsf_parser_frame(const crsf_parser_t *parser, size_t *len)

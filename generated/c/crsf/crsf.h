@@ -52,6 +52,12 @@ extern "C" {
 #ifndef CRSF_PARSER_WHOLE_FRAMES
 #define CRSF_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: crsf_parser_push reports a frame of an unknown command with a good checksum
+ * (CRSF_EVENT_FRAME_UNKNOWN) and crsf_parser_frame gives it from a copy in the parser (CRSF_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef CRSF_PARSER_UNKNOWN_FRAMES
+#define CRSF_PARSER_UNKNOWN_FRAMES 1
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 257 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -272,6 +278,12 @@ typedef struct {
     } u;
 } crsf_msg_t;
 
+/* What one byte did (crsf_parser_push): nothing complete; a message (in *out, its bytes
+ * crsf_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (crsf_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { CRSF_EVENT_NONE = 0, CRSF_EVENT_MESSAGE, CRSF_EVENT_FRAME_UNKNOWN } crsf_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     crsf_direction_t dir;
@@ -279,12 +291,17 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* frames of an unknown command with a good checksum (CRSF_EVENT_FRAME_UNKNOWN), among the errors */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     const uint8_t *frame;             /* the last frame delivered, as received (crsf_parser_frame) */
     size_t frame_len;
     crsf_kind_t expect;                 /* crsf_parser_expect */
     uint8_t buf[CRSF_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[CRSF_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+#if CRSF_PARSER_UNKNOWN_FRAMES
+    uint8_t unknown_frame[CRSF_MAX_FRAME]; /* the last one, for crsf_parser_frame */
+    size_t unknown_len;
+#endif
 } crsf_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -315,6 +332,9 @@ int crsf_encode_device_info_response(const crsf_device_info_response_t *m, uint8
  * counters. Work per byte is bounded by CRSF_MAX_FRAME candidate checks, each candidate decoded once. */
 void crsf_parser_init(crsf_parser_t *parser, crsf_direction_t dir);
 size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, crsf_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as crsf_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+crsf_event_t crsf_parser_push(crsf_parser_t *parser, uint8_t byte, crsf_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void crsf_parser_gap(crsf_parser_t *parser);

@@ -1993,6 +1993,7 @@ int dynamixel_p2_encode(const dynamixel_p2_msg_t *msg, uint8_t *buf, size_t cap,
 #define DYNAMIXEL_P2__V_WAIT 3
 #define DYNAMIXEL_P2__V_NONE 1
 #define DYNAMIXEL_P2__V_CORRUPT 2
+#define DYNAMIXEL_P2__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direction_t dir)
 {
@@ -2001,11 +2002,13 @@ void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direct
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_msg_t *out, size_t *size)
 {
     uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2024,7 +2027,12 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
             }
             continue;
         }
-        if (dynamixel_p2_decode_expect(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), p->expect, out) != DYNAMIXEL_P2_OK) {
+        r = dynamixel_p2_decode_expect(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), p->expect, out);
+        if (r == DYNAMIXEL_P2_E_UNKNOWN) {
+            *size = (size_t)s;
+            return DYNAMIXEL_P2__V_UNKNOWN;
+        }
+        if (r != DYNAMIXEL_P2_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = DYNAMIXEL_P2__V_CORRUPT;
             }
@@ -2088,6 +2096,22 @@ static void dynamixel_p2__drop(dynamixel_p2_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for dynamixel_p2_parser_push's
+ * DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void dynamixel_p2__keep_unknown(dynamixel_p2_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if DYNAMIXEL_P2__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int dynamixel_p2__ends_header(const dynamixel_p2_parser_t *p)
@@ -2110,7 +2134,7 @@ static int dynamixel_p2__ends_header(const dynamixel_p2_parser_t *p)
 static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_p2_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= DYNAMIXEL_P2_MAX_FRAME) { /* only a candidate longer than DYNAMIXEL_P2_MAX_FRAME can fill it: drop its first byte */
         dynamixel_p2__drop(p, 1u);
         p->garbage++;
@@ -2139,9 +2163,18 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == DYNAMIXEL_P2__V_CORRUPT) {
+        } else if (r == DYNAMIXEL_P2__V_CORRUPT || r == DYNAMIXEL_P2__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == DYNAMIXEL_P2__V_UNKNOWN) {
+                    p->unknown++;
+#if DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        dynamixel_p2__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2176,7 +2209,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     if (cut > 0u) {
         dynamixel_p2__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if DYNAMIXEL_P2__HEADERS && DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
@@ -2234,7 +2267,7 @@ size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *da
             }
         }
 #endif
-        if (dynamixel_p2__push(parser, data[i], out)) {
+        if (dynamixel_p2__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2247,6 +2280,27 @@ void dynamixel_p2_parser_gap(dynamixel_p2_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+dynamixel_p2_event_t dynamixel_p2_parser_push(dynamixel_p2_parser_t *parser, uint8_t byte, dynamixel_p2_msg_t *out)
+{
+#if DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_BOTH
+    if (!DYNAMIXEL_P2__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return DYNAMIXEL_P2_EVENT_NONE;
+    }
+#endif
+    switch (dynamixel_p2__push(parser, byte, out)) {
+    case 1:
+        return DYNAMIXEL_P2_EVENT_MESSAGE;
+    case 2:
+#if DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return DYNAMIXEL_P2_EVENT_NONE;
+    }
 }
 
 const uint8_t *dynamixel_p2_parser_frame(const dynamixel_p2_parser_t *parser, size_t *len)

@@ -52,6 +52,12 @@ extern "C" {
 #ifndef DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
 #define DYNAMIXEL_P2_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: dynamixel_p2_parser_push reports a frame of an unknown command with a good checksum
+ * (DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN) and dynamixel_p2_parser_frame gives it from a copy in the parser (DYNAMIXEL_P2_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
+#define DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES 1
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65542 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -330,6 +336,12 @@ typedef struct {
     } u;
 } dynamixel_p2_msg_t;
 
+/* What one byte did (dynamixel_p2_parser_push): nothing complete; a message (in *out, its bytes
+ * dynamixel_p2_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (dynamixel_p2_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { DYNAMIXEL_P2_EVENT_NONE = 0, DYNAMIXEL_P2_EVENT_MESSAGE, DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN } dynamixel_p2_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     dynamixel_p2_direction_t dir;
@@ -337,12 +349,17 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* frames of an unknown command with a good checksum (DYNAMIXEL_P2_EVENT_FRAME_UNKNOWN), among the errors */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     const uint8_t *frame;             /* the last frame delivered, as received (dynamixel_p2_parser_frame) */
     size_t frame_len;
     dynamixel_p2_kind_t expect;                 /* dynamixel_p2_parser_expect */
     uint8_t buf[DYNAMIXEL_P2_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[DYNAMIXEL_P2_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+#if DYNAMIXEL_P2_PARSER_UNKNOWN_FRAMES
+    uint8_t unknown_frame[DYNAMIXEL_P2_MAX_FRAME]; /* the last one, for dynamixel_p2_parser_frame */
+    size_t unknown_len;
+#endif
 } dynamixel_p2_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -374,6 +391,9 @@ int dynamixel_p2_encode_status_response(const dynamixel_p2_status_response_t *m,
  * counters. Work per byte is bounded by DYNAMIXEL_P2_MAX_FRAME candidate checks, each candidate decoded once. */
 void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direction_t dir);
 size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as dynamixel_p2_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+dynamixel_p2_event_t dynamixel_p2_parser_push(dynamixel_p2_parser_t *parser, uint8_t byte, dynamixel_p2_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void dynamixel_p2_parser_gap(dynamixel_p2_parser_t *parser);

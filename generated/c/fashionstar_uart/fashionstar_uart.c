@@ -4714,6 +4714,23 @@ void fashionstar_uart_parser_gap(fashionstar_uart_parser_t *parser)
     parser->wake = 0u;
 }
 
+fashionstar_uart_event_t fashionstar_uart_parser_push(fashionstar_uart_parser_t *parser, uint8_t byte, fashionstar_uart_msg_t *out)
+{
+#if FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_BOTH
+    if (!FASHIONSTAR_UART__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return FASHIONSTAR_UART_EVENT_NONE;
+    }
+#endif
+    switch (fashionstar_uart__push(parser, byte, out)) {
+    case 1:
+        return FASHIONSTAR_UART_EVENT_MESSAGE;
+    case 2:
+        return FASHIONSTAR_UART_EVENT_FRAME_UNKNOWN;
+    default:
+        return FASHIONSTAR_UART_EVENT_NONE;
+    }
+}
+
 const uint8_t *fashionstar_uart_parser_frame(const fashionstar_uart_parser_t *parser, size_t *len)
 {
     if (len != NULL) {

@@ -539,6 +539,12 @@ typedef struct {
     } u;
 } fashionstar_uart_msg_t;
 
+/* What one byte did (fashionstar_uart_parser_push): nothing complete; a message (in *out, its bytes
+ * fashionstar_uart_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (fashionstar_uart_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { FASHIONSTAR_UART_EVENT_NONE = 0, FASHIONSTAR_UART_EVENT_MESSAGE, FASHIONSTAR_UART_EVENT_FRAME_UNKNOWN } fashionstar_uart_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     fashionstar_uart_direction_t dir;
@@ -546,6 +552,7 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* always 0 here: an unknown command's frame is no candidate (docs/c.md) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
     const uint8_t *frame;             /* the last frame delivered, as received (fashionstar_uart_parser_frame) */
@@ -608,6 +615,9 @@ int fashionstar_uart_encode_sync_command_request(const fashionstar_uart_sync_com
  * counters. Work per byte is bounded by FASHIONSTAR_UART_MAX_FRAME candidate checks, each candidate decoded once. */
 void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar_uart_direction_t dir);
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as fashionstar_uart_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+fashionstar_uart_event_t fashionstar_uart_parser_push(fashionstar_uart_parser_t *parser, uint8_t byte, fashionstar_uart_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void fashionstar_uart_parser_gap(fashionstar_uart_parser_t *parser);

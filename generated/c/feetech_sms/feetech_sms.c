@@ -1827,6 +1827,23 @@ void feetech_sms_parser_gap(feetech_sms_parser_t *parser)
     parser->wake = 0u;
 }
 
+feetech_sms_event_t feetech_sms_parser_push(feetech_sms_parser_t *parser, uint8_t byte, feetech_sms_msg_t *out)
+{
+#if FEETECH_SMS_ROLE != FEETECH_SMS_ROLE_BOTH
+    if (!FEETECH_SMS__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return FEETECH_SMS_EVENT_NONE;
+    }
+#endif
+    switch (feetech_sms__push(parser, byte, out)) {
+    case 1:
+        return FEETECH_SMS_EVENT_MESSAGE;
+    case 2:
+        return FEETECH_SMS_EVENT_FRAME_UNKNOWN;
+    default:
+        return FEETECH_SMS_EVENT_NONE;
+    }
+}
+
 const uint8_t *feetech_sms_parser_frame(const feetech_sms_parser_t *parser, size_t *len)
 {
     if (len != NULL) {

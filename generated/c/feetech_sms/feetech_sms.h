@@ -229,6 +229,12 @@ typedef struct {
     } u;
 } feetech_sms_msg_t;
 
+/* What one byte did (feetech_sms_parser_push): nothing complete; a message (in *out, its bytes
+ * feetech_sms_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (feetech_sms_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { FEETECH_SMS_EVENT_NONE = 0, FEETECH_SMS_EVENT_MESSAGE, FEETECH_SMS_EVENT_FRAME_UNKNOWN } feetech_sms_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     feetech_sms_direction_t dir;
@@ -236,6 +242,7 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* always 0 here: an unknown command's frame is no candidate (docs/c.md) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
     const uint8_t *frame;             /* the last frame delivered, as received (feetech_sms_parser_frame) */
@@ -267,6 +274,9 @@ int feetech_sms_encode_reply_response(const feetech_sms_reply_response_t *m, uin
  * counters. Work per byte is bounded by FEETECH_SMS_MAX_FRAME candidate checks, each candidate decoded once. */
 void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction_t dir);
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as feetech_sms_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+feetech_sms_event_t feetech_sms_parser_push(feetech_sms_parser_t *parser, uint8_t byte, feetech_sms_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void feetech_sms_parser_gap(feetech_sms_parser_t *parser);

@@ -4634,6 +4634,23 @@ void hiwonder_rrc_parser_gap(hiwonder_rrc_parser_t *parser)
     parser->wake = 0u;
 }
 
+hiwonder_rrc_event_t hiwonder_rrc_parser_push(hiwonder_rrc_parser_t *parser, uint8_t byte, hiwonder_rrc_msg_t *out)
+{
+#if HIWONDER_RRC_ROLE != HIWONDER_RRC_ROLE_BOTH
+    if (!HIWONDER_RRC__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return HIWONDER_RRC_EVENT_NONE;
+    }
+#endif
+    switch (hiwonder_rrc__push(parser, byte, out)) {
+    case 1:
+        return HIWONDER_RRC_EVENT_MESSAGE;
+    case 2:
+        return HIWONDER_RRC_EVENT_FRAME_UNKNOWN;
+    default:
+        return HIWONDER_RRC_EVENT_NONE;
+    }
+}
+
 const uint8_t *hiwonder_rrc_parser_frame(const hiwonder_rrc_parser_t *parser, size_t *len)
 {
     if (len != NULL) {

@@ -589,6 +589,12 @@ typedef struct {
     } u;
 } hiwonder_rrc_msg_t;
 
+/* What one byte did (hiwonder_rrc_parser_push): nothing complete; a message (in *out, its bytes
+ * hiwonder_rrc_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (hiwonder_rrc_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { HIWONDER_RRC_EVENT_NONE = 0, HIWONDER_RRC_EVENT_MESSAGE, HIWONDER_RRC_EVENT_FRAME_UNKNOWN } hiwonder_rrc_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     hiwonder_rrc_direction_t dir;
@@ -596,6 +602,7 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* always 0 here: an unknown command's frame is no candidate (docs/c.md) */
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
     const uint8_t *frame;             /* the last frame delivered, as received (hiwonder_rrc_parser_frame) */
@@ -667,6 +674,9 @@ int hiwonder_rrc_encode_rgb_set_pixels_request(const hiwonder_rrc_rgb_set_pixels
  * counters. Work per byte is bounded by HIWONDER_RRC_MAX_FRAME candidate checks, each candidate decoded once. */
 void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direction_t dir);
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as hiwonder_rrc_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+hiwonder_rrc_event_t hiwonder_rrc_parser_push(hiwonder_rrc_parser_t *parser, uint8_t byte, hiwonder_rrc_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void hiwonder_rrc_parser_gap(hiwonder_rrc_parser_t *parser);

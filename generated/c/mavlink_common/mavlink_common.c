@@ -2699,6 +2699,7 @@ int mavlink_common_encode(const mavlink_common_msg_t *msg, uint8_t *buf, size_t 
 #define MAVLINK_COMMON__V_WAIT 3
 #define MAVLINK_COMMON__V_NONE 1
 #define MAVLINK_COMMON__V_CORRUPT 2
+#define MAVLINK_COMMON__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void mavlink_common_parser_init(mavlink_common_parser_t *parser, mavlink_common_direction_t dir)
 {
@@ -2707,11 +2708,13 @@ void mavlink_common_parser_init(mavlink_common_parser_t *parser, mavlink_common_
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int mavlink_common__try(mavlink_common_parser_t *p, size_t pos, mavlink_common_msg_t *out, size_t *size)
 {
     uint8_t count = mavlink_common__count(MAVLINK_COMMON__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2730,7 +2733,12 @@ static int mavlink_common__try(mavlink_common_parser_t *p, size_t pos, mavlink_c
             }
             continue;
         }
-        if (mavlink_common_decode_expect(p->buf + pos, (size_t)s, MAVLINK_COMMON__RX(p->dir), p->expect, out) != MAVLINK_COMMON_OK) {
+        r = mavlink_common_decode_expect(p->buf + pos, (size_t)s, MAVLINK_COMMON__RX(p->dir), p->expect, out);
+        if (r == MAVLINK_COMMON_E_UNKNOWN) {
+            *size = (size_t)s;
+            return MAVLINK_COMMON__V_UNKNOWN;
+        }
+        if (r != MAVLINK_COMMON_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MAVLINK_COMMON__V_CORRUPT;
             }
@@ -2794,6 +2802,22 @@ static void mavlink_common__drop(mavlink_common_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for mavlink_common_parser_push's
+ * MAVLINK_COMMON_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void mavlink_common__keep_unknown(mavlink_common_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if MAVLINK_COMMON__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int mavlink_common__ends_header(const mavlink_common_parser_t *p)
@@ -2816,7 +2840,7 @@ static int mavlink_common__ends_header(const mavlink_common_parser_t *p)
 static int mavlink_common__push(mavlink_common_parser_t *p, uint8_t byte, mavlink_common_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= MAVLINK_COMMON_MAX_FRAME) { /* only a candidate longer than MAVLINK_COMMON_MAX_FRAME can fill it: drop its first byte */
         mavlink_common__drop(p, 1u);
         p->garbage++;
@@ -2845,9 +2869,18 @@ static int mavlink_common__push(mavlink_common_parser_t *p, uint8_t byte, mavlin
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == MAVLINK_COMMON__V_CORRUPT) {
+        } else if (r == MAVLINK_COMMON__V_CORRUPT || r == MAVLINK_COMMON__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == MAVLINK_COMMON__V_UNKNOWN) {
+                    p->unknown++;
+#if MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        mavlink_common__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2882,7 +2915,7 @@ static int mavlink_common__push(mavlink_common_parser_t *p, uint8_t byte, mavlin
     if (cut > 0u) {
         mavlink_common__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if MAVLINK_COMMON__HEADERS && MAVLINK_COMMON_PARSER_WHOLE_FRAMES
@@ -2940,7 +2973,7 @@ size_t mavlink_common_parser_feed(mavlink_common_parser_t *parser, const uint8_t
             }
         }
 #endif
-        if (mavlink_common__push(parser, data[i], out)) {
+        if (mavlink_common__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2953,6 +2986,27 @@ void mavlink_common_parser_gap(mavlink_common_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+mavlink_common_event_t mavlink_common_parser_push(mavlink_common_parser_t *parser, uint8_t byte, mavlink_common_msg_t *out)
+{
+#if MAVLINK_COMMON_ROLE != MAVLINK_COMMON_ROLE_BOTH
+    if (!MAVLINK_COMMON__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return MAVLINK_COMMON_EVENT_NONE;
+    }
+#endif
+    switch (mavlink_common__push(parser, byte, out)) {
+    case 1:
+        return MAVLINK_COMMON_EVENT_MESSAGE;
+    case 2:
+#if MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return MAVLINK_COMMON_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return MAVLINK_COMMON_EVENT_NONE;
+    }
 }
 
 const uint8_t *mavlink_common_parser_frame(const mavlink_common_parser_t *parser, size_t *len)

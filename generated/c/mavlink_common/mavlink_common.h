@@ -52,6 +52,12 @@ extern "C" {
 #ifndef MAVLINK_COMMON_PARSER_WHOLE_FRAMES
 #define MAVLINK_COMMON_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: mavlink_common_parser_push reports a frame of an unknown command with a good checksum
+ * (MAVLINK_COMMON_EVENT_FRAME_UNKNOWN) and mavlink_common_parser_frame gives it from a copy in the parser (MAVLINK_COMMON_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
+#define MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES 1
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 280 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -393,6 +399,12 @@ typedef struct {
     } u;
 } mavlink_common_msg_t;
 
+/* What one byte did (mavlink_common_parser_push): nothing complete; a message (in *out, its bytes
+ * mavlink_common_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (mavlink_common_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { MAVLINK_COMMON_EVENT_NONE = 0, MAVLINK_COMMON_EVENT_MESSAGE, MAVLINK_COMMON_EVENT_FRAME_UNKNOWN } mavlink_common_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     mavlink_common_direction_t dir;
@@ -400,12 +412,17 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* frames of an unknown command with a good checksum (MAVLINK_COMMON_EVENT_FRAME_UNKNOWN), among the errors */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     const uint8_t *frame;             /* the last frame delivered, as received (mavlink_common_parser_frame) */
     size_t frame_len;
     mavlink_common_kind_t expect;                 /* mavlink_common_parser_expect */
     uint8_t buf[MAVLINK_COMMON_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[MAVLINK_COMMON_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+#if MAVLINK_COMMON_PARSER_UNKNOWN_FRAMES
+    uint8_t unknown_frame[MAVLINK_COMMON_MAX_FRAME]; /* the last one, for mavlink_common_parser_frame */
+    size_t unknown_len;
+#endif
 } mavlink_common_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -431,6 +448,9 @@ int mavlink_common_encode_command_ack_response(const mavlink_common_command_ack_
  * counters. Work per byte is bounded by MAVLINK_COMMON_MAX_FRAME candidate checks, each candidate decoded once. */
 void mavlink_common_parser_init(mavlink_common_parser_t *parser, mavlink_common_direction_t dir);
 size_t mavlink_common_parser_feed(mavlink_common_parser_t *parser, const uint8_t *data, size_t len, mavlink_common_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as mavlink_common_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+mavlink_common_event_t mavlink_common_parser_push(mavlink_common_parser_t *parser, uint8_t byte, mavlink_common_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void mavlink_common_parser_gap(mavlink_common_parser_t *parser);

@@ -2563,6 +2563,7 @@ int modbus_ascii_encode(const modbus_ascii_msg_t *msg, uint8_t *buf, size_t cap,
 #define MODBUS_ASCII__V_WAIT 3
 #define MODBUS_ASCII__V_NONE 1
 #define MODBUS_ASCII__V_CORRUPT 2
+#define MODBUS_ASCII__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void modbus_ascii_parser_init(modbus_ascii_parser_t *parser, modbus_ascii_direction_t dir)
 {
@@ -2571,11 +2572,13 @@ void modbus_ascii_parser_init(modbus_ascii_parser_t *parser, modbus_ascii_direct
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_msg_t *out, size_t *size)
 {
     uint8_t count = modbus_ascii__count(MODBUS_ASCII__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2594,7 +2597,12 @@ static int modbus_ascii__try(modbus_ascii_parser_t *p, size_t pos, modbus_ascii_
             }
             continue;
         }
-        if (modbus_ascii_decode_expect(p->buf + pos, (size_t)s, MODBUS_ASCII__RX(p->dir), p->expect, out) != MODBUS_ASCII_OK) {
+        r = modbus_ascii_decode_expect(p->buf + pos, (size_t)s, MODBUS_ASCII__RX(p->dir), p->expect, out);
+        if (r == MODBUS_ASCII_E_UNKNOWN) {
+            *size = (size_t)s;
+            return MODBUS_ASCII__V_UNKNOWN;
+        }
+        if (r != MODBUS_ASCII_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_ASCII__V_CORRUPT;
             }
@@ -2658,6 +2666,22 @@ static void modbus_ascii__drop(modbus_ascii_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for modbus_ascii_parser_push's
+ * MODBUS_ASCII_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void modbus_ascii__keep_unknown(modbus_ascii_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if MODBUS_ASCII__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int modbus_ascii__ends_header(const modbus_ascii_parser_t *p)
@@ -2680,7 +2704,7 @@ static int modbus_ascii__ends_header(const modbus_ascii_parser_t *p)
 static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_ascii_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= MODBUS_ASCII_MAX_FRAME) { /* only a candidate longer than MODBUS_ASCII_MAX_FRAME can fill it: drop its first byte */
         modbus_ascii__drop(p, 1u);
         p->garbage++;
@@ -2709,9 +2733,18 @@ static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_asc
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == MODBUS_ASCII__V_CORRUPT) {
+        } else if (r == MODBUS_ASCII__V_CORRUPT || r == MODBUS_ASCII__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == MODBUS_ASCII__V_UNKNOWN) {
+                    p->unknown++;
+#if MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        modbus_ascii__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2746,7 +2779,7 @@ static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_asc
     if (cut > 0u) {
         modbus_ascii__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if MODBUS_ASCII__HEADERS && MODBUS_ASCII_PARSER_WHOLE_FRAMES
@@ -2804,7 +2837,7 @@ size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *da
             }
         }
 #endif
-        if (modbus_ascii__push(parser, data[i], out)) {
+        if (modbus_ascii__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2817,6 +2850,27 @@ void modbus_ascii_parser_gap(modbus_ascii_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+modbus_ascii_event_t modbus_ascii_parser_push(modbus_ascii_parser_t *parser, uint8_t byte, modbus_ascii_msg_t *out)
+{
+#if MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_BOTH
+    if (!MODBUS_ASCII__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return MODBUS_ASCII_EVENT_NONE;
+    }
+#endif
+    switch (modbus_ascii__push(parser, byte, out)) {
+    case 1:
+        return MODBUS_ASCII_EVENT_MESSAGE;
+    case 2:
+#if MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return MODBUS_ASCII_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return MODBUS_ASCII_EVENT_NONE;
+    }
 }
 
 const uint8_t *modbus_ascii_parser_frame(const modbus_ascii_parser_t *parser, size_t *len)

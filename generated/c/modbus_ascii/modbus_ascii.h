@@ -52,6 +52,12 @@ extern "C" {
 #ifndef MODBUS_ASCII_PARSER_WHOLE_FRAMES
 #define MODBUS_ASCII_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: modbus_ascii_parser_push reports a frame of an unknown command with a good checksum
+ * (MODBUS_ASCII_EVENT_FRAME_UNKNOWN) and modbus_ascii_parser_frame gives it from a copy in the parser (MODBUS_ASCII_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
+#define MODBUS_ASCII_PARSER_UNKNOWN_FRAMES 1
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 1073741824 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -326,6 +332,12 @@ typedef struct {
     } u;
 } modbus_ascii_msg_t;
 
+/* What one byte did (modbus_ascii_parser_push): nothing complete; a message (in *out, its bytes
+ * modbus_ascii_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (modbus_ascii_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { MODBUS_ASCII_EVENT_NONE = 0, MODBUS_ASCII_EVENT_MESSAGE, MODBUS_ASCII_EVENT_FRAME_UNKNOWN } modbus_ascii_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     modbus_ascii_direction_t dir;
@@ -333,12 +345,17 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* frames of an unknown command with a good checksum (MODBUS_ASCII_EVENT_FRAME_UNKNOWN), among the errors */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     const uint8_t *frame;             /* the last frame delivered, as received (modbus_ascii_parser_frame) */
     size_t frame_len;
     modbus_ascii_kind_t expect;                 /* modbus_ascii_parser_expect */
     uint8_t buf[MODBUS_ASCII_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[MODBUS_ASCII_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+#if MODBUS_ASCII_PARSER_UNKNOWN_FRAMES
+    uint8_t unknown_frame[MODBUS_ASCII_MAX_FRAME]; /* the last one, for modbus_ascii_parser_frame */
+    size_t unknown_len;
+#endif
 } modbus_ascii_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -376,6 +393,9 @@ int modbus_ascii_encode_exception_response(const modbus_ascii_exception_response
  * counters. Work per byte is bounded by MODBUS_ASCII_MAX_FRAME candidate checks, each candidate decoded once. */
 void modbus_ascii_parser_init(modbus_ascii_parser_t *parser, modbus_ascii_direction_t dir);
 size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *data, size_t len, modbus_ascii_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as modbus_ascii_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+modbus_ascii_event_t modbus_ascii_parser_push(modbus_ascii_parser_t *parser, uint8_t byte, modbus_ascii_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void modbus_ascii_parser_gap(modbus_ascii_parser_t *parser);

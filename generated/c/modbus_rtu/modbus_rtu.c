@@ -2588,6 +2588,7 @@ int modbus_rtu_encode(const modbus_rtu_msg_t *msg, uint8_t *buf, size_t cap, siz
 #define MODBUS_RTU__V_WAIT 3
 #define MODBUS_RTU__V_NONE 1
 #define MODBUS_RTU__V_CORRUPT 2
+#define MODBUS_RTU__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void modbus_rtu_parser_init(modbus_rtu_parser_t *parser, modbus_rtu_direction_t dir)
 {
@@ -2596,11 +2597,13 @@ void modbus_rtu_parser_init(modbus_rtu_parser_t *parser, modbus_rtu_direction_t 
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t *out, size_t *size)
 {
     uint8_t count = modbus_rtu__count(MODBUS_RTU__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2619,7 +2622,12 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
             }
             continue;
         }
-        if (modbus_rtu_decode_expect(p->buf + pos, (size_t)s, MODBUS_RTU__RX(p->dir), p->expect, out) != MODBUS_RTU_OK) {
+        r = modbus_rtu_decode_expect(p->buf + pos, (size_t)s, MODBUS_RTU__RX(p->dir), p->expect, out);
+        if (r == MODBUS_RTU_E_UNKNOWN) {
+            *size = (size_t)s;
+            return MODBUS_RTU__V_UNKNOWN;
+        }
+        if (r != MODBUS_RTU_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_RTU__V_CORRUPT;
             }
@@ -2683,6 +2691,22 @@ static void modbus_rtu__drop(modbus_rtu_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if MODBUS_RTU_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for modbus_rtu_parser_push's
+ * MODBUS_RTU_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void modbus_rtu__keep_unknown(modbus_rtu_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if MODBUS_RTU__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int modbus_rtu__ends_header(const modbus_rtu_parser_t *p)
@@ -2705,7 +2729,7 @@ static int modbus_rtu__ends_header(const modbus_rtu_parser_t *p)
 static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= MODBUS_RTU_MAX_FRAME) { /* only a candidate longer than MODBUS_RTU_MAX_FRAME can fill it: drop its first byte */
         modbus_rtu__drop(p, 1u);
         p->garbage++;
@@ -2734,9 +2758,18 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == MODBUS_RTU__V_CORRUPT) {
+        } else if (r == MODBUS_RTU__V_CORRUPT || r == MODBUS_RTU__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == MODBUS_RTU__V_UNKNOWN) {
+                    p->unknown++;
+#if MODBUS_RTU_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        modbus_rtu__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2771,7 +2804,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     if (cut > 0u) {
         modbus_rtu__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if MODBUS_RTU__HEADERS && MODBUS_RTU_PARSER_WHOLE_FRAMES
@@ -2829,7 +2862,7 @@ size_t modbus_rtu_parser_feed(modbus_rtu_parser_t *parser, const uint8_t *data, 
             }
         }
 #endif
-        if (modbus_rtu__push(parser, data[i], out)) {
+        if (modbus_rtu__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2842,6 +2875,27 @@ void modbus_rtu_parser_gap(modbus_rtu_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+modbus_rtu_event_t modbus_rtu_parser_push(modbus_rtu_parser_t *parser, uint8_t byte, modbus_rtu_msg_t *out)
+{
+#if MODBUS_RTU_ROLE != MODBUS_RTU_ROLE_BOTH
+    if (!MODBUS_RTU__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return MODBUS_RTU_EVENT_NONE;
+    }
+#endif
+    switch (modbus_rtu__push(parser, byte, out)) {
+    case 1:
+        return MODBUS_RTU_EVENT_MESSAGE;
+    case 2:
+#if MODBUS_RTU_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return MODBUS_RTU_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return MODBUS_RTU_EVENT_NONE;
+    }
 }
 
 const uint8_t *modbus_rtu_parser_frame(const modbus_rtu_parser_t *parser, size_t *len)

@@ -1939,6 +1939,12 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
                 return 1;
             }
             p->errors++;
+            if (r == NMEA0183_E_UNKNOWN && p->n == 0u) { /* a good checksum, an unknown code: still in the buffer */
+                p->unknown++;
+                p->frame = p->buf;
+                p->frame_len = end + k;
+                return 2;
+            }
         }
     }
 }
@@ -1950,6 +1956,7 @@ void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;
+    parser->unknown = 0u;
     parser->frame = NULL;
     parser->frame_len = 0u;
 }
@@ -1971,6 +1978,23 @@ size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size
         return len;
     }
 
+nmea0183_event_t nmea0183_parser_push(nmea0183_parser_t *parser, uint8_t byte, nmea0183_msg_t *out)
+{
+#if NMEA0183_ROLE != NMEA0183_ROLE_BOTH
+    if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return NMEA0183_EVENT_NONE;
+    }
+#endif
+    switch (nmea0183__push(parser, byte, out)) {
+    case 1:
+        return NMEA0183_EVENT_MESSAGE;
+    case 2:
+        return NMEA0183_EVENT_FRAME_UNKNOWN;
+    default:
+        return NMEA0183_EVENT_NONE;
+    }
+}
+
 const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len)
 {
     if (len != NULL) {
@@ -1986,12 +2010,29 @@ void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
 }
 #endif
     for (i = 0u; i < len; i++) {
-        if (nmea0183__push(parser, data[i], out)) {
+        if (nmea0183__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
     }
     return len;
+}
+
+nmea0183_event_t nmea0183_parser_push(nmea0183_parser_t *parser, uint8_t byte, nmea0183_msg_t *out)
+{
+#if NMEA0183_ROLE != NMEA0183_ROLE_BOTH
+    if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return NMEA0183_EVENT_NONE;
+    }
+#endif
+    switch (nmea0183__push(parser, byte, out)) {
+    case 1:
+        return NMEA0183_EVENT_MESSAGE;
+    case 2:
+        return NMEA0183_EVENT_FRAME_UNKNOWN;
+    default:
+        return NMEA0183_EVENT_NONE;
+    }
 }
 
 const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len)

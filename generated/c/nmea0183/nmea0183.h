@@ -295,6 +295,12 @@ typedef struct {
     } u;
 } nmea0183_msg_t;
 
+/* What one byte did (nmea0183_parser_push): nothing complete; a message (in *out, its bytes
+ * nmea0183_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (nmea0183_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { NMEA0183_EVENT_NONE = 0, NMEA0183_EVENT_MESSAGE, NMEA0183_EVENT_FRAME_UNKNOWN } nmea0183_event_t;
+
 /* All parser state (runtime/text.py TextStreamParser): the line being read and the counters. */
 typedef struct {
     nmea0183_direction_t dir;
@@ -303,6 +309,7 @@ typedef struct {
     uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
+    uint32_t unknown; /* of those, frames with a good checksum and an unknown code (NMEA0183_EVENT_FRAME_UNKNOWN) */
     const uint8_t *frame; /* the last frame delivered, as received (nmea0183_parser_frame) */
     size_t frame_len;
 } nmea0183_parser_t;
@@ -317,6 +324,9 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
 int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir);
 size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size_t len, nmea0183_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as nmea0183_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+nmea0183_event_t nmea0183_parser_push(nmea0183_parser_t *parser, uint8_t byte, nmea0183_msg_t *out);
 /* The line went idle: no frame spans a gap, so a frame begun is dropped as cut short (counted in errors), as Python's
  * TextStreamParser.gap() does. */
 void nmea0183_parser_gap(nmea0183_parser_t *parser);

@@ -2301,6 +2301,7 @@ int ubx_encode(const ubx_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 #define UBX__V_WAIT 3
 #define UBX__V_NONE 1
 #define UBX__V_CORRUPT 2
+#define UBX__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void ubx_parser_init(ubx_parser_t *parser, ubx_direction_t dir)
 {
@@ -2309,11 +2310,13 @@ void ubx_parser_init(ubx_parser_t *parser, ubx_direction_t dir)
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
 {
     uint8_t count = ubx__count(UBX__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2332,7 +2335,12 @@ static int ubx__try(ubx_parser_t *p, size_t pos, ubx_msg_t *out, size_t *size)
             }
             continue;
         }
-        if (ubx_decode_expect(p->buf + pos, (size_t)s, UBX__RX(p->dir), p->expect, out) != UBX_OK) {
+        r = ubx_decode_expect(p->buf + pos, (size_t)s, UBX__RX(p->dir), p->expect, out);
+        if (r == UBX_E_UNKNOWN) {
+            *size = (size_t)s;
+            return UBX__V_UNKNOWN;
+        }
+        if (r != UBX_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = UBX__V_CORRUPT;
             }
@@ -2396,6 +2404,22 @@ static void ubx__drop(ubx_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if UBX_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for ubx_parser_push's
+ * UBX_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void ubx__keep_unknown(ubx_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if UBX__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int ubx__ends_header(const ubx_parser_t *p)
@@ -2418,7 +2442,7 @@ static int ubx__ends_header(const ubx_parser_t *p)
 static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= UBX_MAX_FRAME) { /* only a candidate longer than UBX_MAX_FRAME can fill it: drop its first byte */
         ubx__drop(p, 1u);
         p->garbage++;
@@ -2447,9 +2471,18 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == UBX__V_CORRUPT) {
+        } else if (r == UBX__V_CORRUPT || r == UBX__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == UBX__V_UNKNOWN) {
+                    p->unknown++;
+#if UBX_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        ubx__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2484,7 +2517,7 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
     if (cut > 0u) {
         ubx__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if UBX__HEADERS && UBX_PARSER_WHOLE_FRAMES
@@ -2542,7 +2575,7 @@ size_t ubx_parser_feed(ubx_parser_t *parser, const uint8_t *data, size_t len, ub
             }
         }
 #endif
-        if (ubx__push(parser, data[i], out)) {
+        if (ubx__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2555,6 +2588,27 @@ void ubx_parser_gap(ubx_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+ubx_event_t ubx_parser_push(ubx_parser_t *parser, uint8_t byte, ubx_msg_t *out)
+{
+#if UBX_ROLE != UBX_ROLE_BOTH
+    if (!UBX__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return UBX_EVENT_NONE;
+    }
+#endif
+    switch (ubx__push(parser, byte, out)) {
+    case 1:
+        return UBX_EVENT_MESSAGE;
+    case 2:
+#if UBX_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return UBX_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return UBX_EVENT_NONE;
+    }
 }
 
 const uint8_t *ubx_parser_frame(const ubx_parser_t *parser, size_t *len)

@@ -2275,6 +2275,7 @@ int vesc_encode(const vesc_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 #define VESC__V_WAIT 3
 #define VESC__V_NONE 1
 #define VESC__V_CORRUPT 2
+#define VESC__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
 {
@@ -2283,11 +2284,13 @@ void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
 }
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size)
 {
     uint8_t count = vesc__count(VESC__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
@@ -2306,7 +2309,12 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
             }
             continue;
         }
-        if (vesc_decode_expect(p->buf + pos, (size_t)s, VESC__RX(p->dir), p->expect, out) != VESC_OK) {
+        r = vesc_decode_expect(p->buf + pos, (size_t)s, VESC__RX(p->dir), p->expect, out);
+        if (r == VESC_E_UNKNOWN) {
+            *size = (size_t)s;
+            return VESC__V_UNKNOWN;
+        }
+        if (r != VESC_OK) {
             if (need == (size_t)-1) {
                 p->verdict[pos] = VESC__V_CORRUPT;
             }
@@ -2370,6 +2378,22 @@ static void vesc__drop(vesc_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
+#if VESC_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for vesc_parser_push's
+ * VESC_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void vesc__keep_unknown(vesc_parser_t *p, size_t pos, size_t size)
+{
+    size_t i;
+    for (i = 0u; i < size; i++) {
+        p->unknown_frame[i] = p->buf[pos + i];
+    }
+    p->unknown_len = size;
+}
+#endif
+
 #if VESC__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int vesc__ends_header(const vesc_parser_t *p)
@@ -2392,7 +2416,7 @@ static int vesc__ends_header(const vesc_parser_t *p)
 static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
 {
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= VESC_MAX_FRAME) { /* only a candidate longer than VESC_MAX_FRAME can fill it: drop its first byte */
         vesc__drop(p, 1u);
         p->garbage++;
@@ -2421,9 +2445,18 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
             } else if (pos + size < wake) {
                 wake = pos + size;
             }
-        } else if (r == VESC__V_CORRUPT) {
+        } else if (r == VESC__V_CORRUPT || r == VESC__V_UNKNOWN) {
             if (hold == (size_t)-1) {
                 p->errors++;
+                if (r == VESC__V_UNKNOWN) {
+                    p->unknown++;
+#if VESC_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) { /* the first of this byte's (a message it completes too comes first) */
+                        vesc__keep_unknown(p, pos, size);
+                    }
+#endif
+                    unknown = 1;
+                }
             }
             if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -2458,7 +2491,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     if (cut > 0u) {
         vesc__drop(p, cut);
     }
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }
 
 #if VESC__HEADERS && VESC_PARSER_WHOLE_FRAMES
@@ -2516,7 +2549,7 @@ size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, 
             }
         }
 #endif
-        if (vesc__push(parser, data[i], out)) {
+        if (vesc__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }
@@ -2529,6 +2562,27 @@ void vesc_parser_gap(vesc_parser_t *parser)
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
     parser->wake = 0u;
+}
+
+vesc_event_t vesc_parser_push(vesc_parser_t *parser, uint8_t byte, vesc_msg_t *out)
+{
+#if VESC_ROLE != VESC_ROLE_BOTH
+    if (!VESC__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
+        return VESC_EVENT_NONE;
+    }
+#endif
+    switch (vesc__push(parser, byte, out)) {
+    case 1:
+        return VESC_EVENT_MESSAGE;
+    case 2:
+#if VESC_PARSER_UNKNOWN_FRAMES
+        parser->frame = parser->unknown_frame;
+        parser->frame_len = parser->unknown_len;
+        return VESC_EVENT_FRAME_UNKNOWN;
+#endif
+    default:
+        return VESC_EVENT_NONE;
+    }
 }
 
 const uint8_t *vesc_parser_frame(const vesc_parser_t *parser, size_t *len)

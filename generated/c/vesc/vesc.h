@@ -52,6 +52,12 @@ extern "C" {
 #ifndef VESC_PARSER_WHOLE_FRAMES
 #define VESC_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: vesc_parser_push reports a frame of an unknown command with a good checksum
+ * (VESC_EVENT_FRAME_UNKNOWN) and vesc_parser_frame gives it from a copy in the parser (VESC_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef VESC_PARSER_UNKNOWN_FRAMES
+#define VESC_PARSER_UNKNOWN_FRAMES 1
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65541 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -285,6 +291,12 @@ typedef struct {
     } u;
 } vesc_msg_t;
 
+/* What one byte did (vesc_parser_push): nothing complete; a message (in *out, its bytes
+ * vesc_parser_frame's); or a frame whose checksum is good but whose command (or sub-command) the spec does not have,
+ * so a router can still forward it (vesc_parser_frame gives its bytes; *out holds no message). The parser counts
+ * that frame as the Python parser counts it (see docs/c.md) and in `unknown`. */
+typedef enum { VESC_EVENT_NONE = 0, VESC_EVENT_MESSAGE, VESC_EVENT_FRAME_UNKNOWN } vesc_event_t;
+
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {
     vesc_direction_t dir;
@@ -292,12 +304,17 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* frames of an unknown command with a good checksum (VESC_EVENT_FRAME_UNKNOWN), among the errors */
     size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     const uint8_t *frame;             /* the last frame delivered, as received (vesc_parser_frame) */
     size_t frame_len;
     vesc_kind_t expect;                 /* vesc_parser_expect */
     uint8_t buf[VESC_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[VESC_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+#if VESC_PARSER_UNKNOWN_FRAMES
+    uint8_t unknown_frame[VESC_MAX_FRAME]; /* the last one, for vesc_parser_frame */
+    size_t unknown_len;
+#endif
 } vesc_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -328,6 +345,9 @@ int vesc_encode_forward_can_request(const vesc_forward_can_request_t *m, uint8_t
  * counters. Work per byte is bounded by VESC_MAX_FRAME candidate checks, each candidate decoded once. */
 void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir);
 size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, vesc_msg_t *out, bool *got);
+/* One byte in (an interrupt handler's call): what it completed. The same parser as vesc_parser_feed's,
+ * one byte at a time (the two can be mixed on one parser); a frame of an unknown command is an event here only. */
+vesc_event_t vesc_parser_push(vesc_parser_t *parser, uint8_t byte, vesc_msg_t *out);
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void vesc_parser_gap(vesc_parser_t *parser);

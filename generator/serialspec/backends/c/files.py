@@ -143,6 +143,22 @@ def header(ctx: Ctx) -> str:
     guard = f"{P}_H"
     # Python's StreamParser of classic frames has one layout per code and ignores expect(); FrameStreamParser's
     # decodes the frames it takes as the expected reply (replies that share a code)
+    unknown_doc, unknown_frame = (
+        f"frames of an unknown command with a good checksum ({P}_EVENT_FRAME_UNKNOWN), among the errors",
+        f"\n#if {P}_PARSER_UNKNOWN_FRAMES\n    uint8_t unknown_frame[{P}_MAX_FRAME];"
+        f" /* the last one, for {p}_parser_frame */"
+        "\n    size_t unknown_len;\n#endif",
+    )
+    unknown_switch = f"""/* 1: {p}_parser_push reports a frame of an unknown command with a good checksum
+ * ({P}_EVENT_FRAME_UNKNOWN) and {p}_parser_frame gives it from a copy in the parser ({P}_MAX_FRAME bytes of RAM); 0
+ * leaves both out (it is still counted in `unknown`). */
+#ifndef {P}_PARSER_UNKNOWN_FRAMES
+#define {P}_PARSER_UNKNOWN_FRAMES 1
+#endif
+"""
+    if length_byte.applies(protocol):  # a candidate's length is trusted only with a known command (docs/c.md)
+        unknown_doc, unknown_frame = "always 0 here: an unknown command's frame is no candidate (docs/c.md)", ""
+        unknown_switch = ""
     expect_member = (
         "" if protocol.framing.classic else f"    {p}_kind_t expect;                 /* {p}_parser_expect */\n"
     )
@@ -185,7 +201,7 @@ extern "C" {{
 #ifndef {P}_PARSER_WHOLE_FRAMES
 #define {P}_PARSER_WHOLE_FRAMES 1
 #endif
-
+{unknown_switch}
 /* The largest frame the parser holds and the codec unstuffs (the spec allows {spec_max} bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef {P}_MAX_FRAME
@@ -233,6 +249,7 @@ typedef struct {{
     }} u;
 }} {p}_msg_t;
 
+{parser_api.event_type(p, P)}
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {{
     {p}_direction_t dir;
@@ -240,11 +257,12 @@ typedef struct {{
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    uint32_t unknown;                 /* {unknown_doc} */
 {wake}
     const uint8_t *frame;             /* the last frame delivered, as received ({p}_parser_frame) */
     size_t frame_len;
 {expect_member}    uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
-{verdict}
+{verdict}{unknown_frame}
 }} {p}_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -262,6 +280,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
  * counters. Work per byte is bounded by {P}_MAX_FRAME candidate checks, each candidate decoded once. */
 void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir);
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got);
+{parser_api.push_prototype(p)}\
 /* The line went idle (Modbus's 3.5 characters, a UART IDLE interrupt, a read timeout): no frame spans a gap, so the
  * bytes held are dropped, counted as garbage (Python's StreamParser.gap()). */
 void {p}_parser_gap({p}_parser_t *parser);
@@ -1233,6 +1252,11 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     decode_rx = f"{p}_decode" if classic else f"{p}_decode_expect"
     expect_arg = "" if classic else "p->expect, "
     parser_common = parser_api.frame_function(p)
+    parser_push = parser_api.push_function(
+        p,
+        P,
+        "parser->frame = parser->unknown_frame;\n        parser->frame_len = parser->unknown_len;",
+    )
     expect_function = parser_api.expect_function(p, P, classic)
     parsing = f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
@@ -1241,6 +1265,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 #define {P}__V_WAIT 3
 #define {P}__V_NONE 1
 #define {P}__V_CORRUPT 2
+#define {P}__V_UNKNOWN 4 /* corrupt: a good checksum, an unknown command (never kept as a verdict) */
 
 void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
 {{
@@ -1249,11 +1274,13 @@ void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
 }}
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
 static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 {{
     uint8_t count = {p}__count({P}__RX(p->dir)), k;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    int r;
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
     }}
@@ -1272,7 +1299,12 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
             }}
             continue;
         }}
-        if ({decode_rx}(p->buf + pos, (size_t)s, {P}__RX(p->dir), {expect_arg}out) != {P}_OK) {{
+        r = {decode_rx}(p->buf + pos, (size_t)s, {P}__RX(p->dir), {expect_arg}out);
+        if (r == {P}_E_UNKNOWN) {{
+            *size = (size_t)s;
+            return {P}__V_UNKNOWN;
+        }}
+        if (r != {P}_OK) {{
             if (need == (size_t)-1) {{
                 p->verdict[pos] = {P}__V_CORRUPT;
             }}
@@ -1336,6 +1368,22 @@ static void {p}__drop({p}_parser_t *p, size_t cut)
     p->n -= cut;
 }}
 
+#if {P}_PARSER_UNKNOWN_FRAMES
+/* A frame of an unknown command copied out of the bytes held (they move), for {p}_parser_push's
+ * {P}_EVENT_FRAME_UNKNOWN: a loop (GCC would make it a call of the library's memcpy). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void {p}__keep_unknown({p}_parser_t *p, size_t pos, size_t size)
+{{
+    size_t i;
+    for (i = 0u; i < size; i++) {{
+        p->unknown_frame[i] = p->buf[pos + i];
+    }}
+    p->unknown_len = size;
+}}
+#endif
+
 #if {P}__HEADERS
 /* 1 when the bytes held end with a header of any layout (a candidate begins). */
 static int {p}__ends_header(const {p}_parser_t *p)
@@ -1358,7 +1406,7 @@ static int {p}__ends_header(const {p}_parser_t *p)
 static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
 {{
     size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
+    int got = 0, r, unknown = 0;
     if (p->n >= {P}_MAX_FRAME) {{ /* only a candidate longer than {P}_MAX_FRAME can fill it: drop its first byte */
         {p}__drop(p, 1u);
         p->garbage++;
@@ -1387,9 +1435,18 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
             }} else if (pos + size < wake) {{
                 wake = pos + size;
             }}
-        }} else if (r == {P}__V_CORRUPT) {{
+        }} else if (r == {P}__V_CORRUPT || r == {P}__V_UNKNOWN) {{
             if (hold == (size_t)-1) {{
                 p->errors++;
+                if (r == {P}__V_UNKNOWN) {{
+                    p->unknown++;
+#if {P}_PARSER_UNKNOWN_FRAMES
+                    if (!unknown) {{ /* the first of this byte's (a message it completes too comes first) */
+                        {p}__keep_unknown(p, pos, size);
+                    }}
+#endif
+                    unknown = 1;
+                }}
             }}
             if (p->verdict[pos] == 0u) {{ /* corrupt as one layout, while another waits: judged again */
                 wake = 0u;
@@ -1424,7 +1481,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     if (cut > 0u) {{
         {p}__drop(p, cut);
     }}
-    return got;
+    return got ? 1 : unknown ? 2 : 0;
 }}
 
 #if {P}__HEADERS && {P}_PARSER_WHOLE_FRAMES
@@ -1482,7 +1539,7 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
             }}
         }}
 #endif
-        if ({p}__push(parser, data[i], out)) {{
+        if ({p}__push(parser, data[i], out) == 1) {{
             *got = true;
             return i + 1u;
         }}
@@ -1496,7 +1553,7 @@ void {p}_parser_gap({p}_parser_t *parser)
     parser->n = 0u;
     parser->wake = 0u;
 }}
-{parser_common}
+{parser_push}{parser_common}
 {expect_function}#endif
 """
     tail = f"""

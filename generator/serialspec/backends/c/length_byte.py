@@ -379,5 +379,5 @@ void {p}_parser_gap({p}_parser_t *parser)
     parser->first = 0u;
     parser->wake = 0u;
 }}
-{parser_api.frame_function(p)}{parser_api.expect_function(p, P, True)}#endif
+{parser_api.push_function(p, P, None)}{parser_api.frame_function(p)}{parser_api.expect_function(p, P, True)}#endif
 """

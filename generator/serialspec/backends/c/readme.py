@@ -6,6 +6,7 @@ the generated text."""
 from __future__ import annotations
 
 from serialspec import __version__
+from serialspec.backends.c import length_byte
 from serialspec.backends.c.emit import Ctx, Member, msg_id, spec_hash
 from serialspec.backends.c.files import directions, kind_name, max_frame
 from serialspec.backends.c.optional import elements_of
@@ -120,6 +121,9 @@ def readme(ctx: Ctx) -> str:
         f"| `{p}_parser_init(&parser, dir)` | a stream parser; its state is the caller's `{p}_parser_t` |",
         f"| `{p}_parser_feed(&parser, data, len, &msg, &got)` | bytes in as they come; returns how many it took, "
         "`got` when a message came out (call again with the rest, or with 0 bytes, for more) |",
+        f"| `{p}_parser_push(&parser, byte, &msg)` | one byte in (an interrupt handler's call): `{P}_EVENT_NONE`, "
+        f"`{P}_EVENT_MESSAGE` or `{P}_EVENT_FRAME_UNKNOWN` (a good checksum, a command the spec does not have: "
+        f"`{p}_parser_frame` gives it, to forward) |",
         f"| `{p}_parser_gap(&parser)` | the line went idle (a UART IDLE interrupt, a timeout): the bytes held are "
         "dropped, as no frame spans a gap |",
         f"| `{p}_parser_frame(&parser, &len)` | the raw bytes of the last message's frame, for routing (valid until "
@@ -144,6 +148,14 @@ def readme(ctx: Ctx) -> str:
         f"| `{P}_ENABLE_ENCODE` | 1 | the encoders (0: left out) |",
         f"| `{P}_ENABLE_DECODE` | 1 | the decoders (the parser needs them) |",
         f"| `{P}_ENABLE_PARSER` | 1 | the stream parser |",
+        *(
+            []
+            if length_byte.applies(ctx.protocol)
+            else [
+                f"| `{P}_PARSER_UNKNOWN_FRAMES` | 1 | `{P}_EVENT_FRAME_UNKNOWN` and the copy of that frame in the "
+                f"parser (`{P}_MAX_FRAME` bytes of RAM; 0: neither, the frames still counted in `unknown`) |"
+            ]
+        ),
         f"| `{P}_MAX_FRAME` | {default_frame} | the largest frame the parser holds (the spec allows {spec_max} "
         "bytes): the parser's buffer |",
     ]

@@ -234,6 +234,7 @@ typedef struct {{
     }} u;
 }} {p}_msg_t;
 
+{parser_api.event_type(p, P)}
 /* All parser state (runtime/text.py TextStreamParser): the line being read and the counters. */
 typedef struct {{
     {p}_direction_t dir;
@@ -242,6 +243,7 @@ typedef struct {{
     uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
+    uint32_t unknown; /* of those, frames with a good checksum and an unknown code ({P}_EVENT_FRAME_UNKNOWN) */
     const uint8_t *frame; /* the last frame delivered, as received ({p}_parser_frame) */
     size_t frame_len;
 }} {p}_parser_t;
@@ -254,6 +256,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
 void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir);
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got);
+{parser_api.push_prototype(p)}\
 /* The line went idle: no frame spans a gap, so a frame begun is dropped as cut short (counted in errors), as Python's
  * TextStreamParser.gap() does. */
 void {p}_parser_gap({p}_parser_t *parser);
@@ -549,7 +552,12 @@ static int {p}__special(uint8_t c)
         runtime = prefixed(parts)
         # the firmware API beside the parser (parser_api.py), inside the parser's feature switch
         parser = prefixed([PARSER]).replace(
-            "}\n#endif\n", "}\n" + parser_api.frame_function(p) + parser_api.expect_function(p, P, True) + "#endif\n"
+            "}\n#endif\n",
+            "}\n"
+            + parser_api.push_function(p, P, None)
+            + parser_api.frame_function(p)
+            + parser_api.expect_function(p, P, True)
+            + "#endif\n",
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))

@@ -842,6 +842,12 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
                 return 1;
             }
             p->errors++;
+            if (r == PFX_E_UNKNOWN && p->n == 0u) { /* a good checksum, an unknown code: still in the buffer */
+                p->unknown++;
+                p->frame = p->buf;
+                p->frame_len = end + k;
+                return 2;
+            }
         }
     }
 }
@@ -853,6 +859,7 @@ void pfx_parser_init(pfx_parser_t *parser, pfx_direction_t dir)
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;
+    parser->unknown = 0u;
     parser->frame = NULL;
     parser->frame_len = 0u;
 }
@@ -875,7 +882,7 @@ size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pf
     }
 #endif
     for (i = 0u; i < len; i++) {
-        if (pfx__push(parser, data[i], out)) {
+        if (pfx__push(parser, data[i], out) == 1) {
             *got = true;
             return i + 1u;
         }

@@ -28,5 +28,10 @@ def serve(spec: str, *ids: int, options: Sequence[str] = ()) -> Iterator[str]:
         yield path
     finally:
         process.send_signal(signal.SIGTERM)
-        code = process.wait(5)
+        try:
+            code = process.wait(5)
+        except subprocess.TimeoutExpired:
+            process.kill()  # say what it was doing rather than leave it behind
+            _, err = process.communicate(timeout=5)
+            raise AssertionError(f"sim still running 5 s after SIGTERM; stderr: {err}") from None
         assert code == 0, f"sim exited with {code}"

@@ -70,7 +70,9 @@ class Simulator(Engine):
         self._outbox: list[_Scheduled] = []
         self._seq = 0
         self._wake_r, self._wake_w = os.pipe()
-        self._stop = threading.Event()
+        # A plain flag, not a threading.Event: stop() runs in signal handlers (`sim` on SIGTERM), and an Event's set()
+        # takes a lock that the interrupted thread may be holding inside its own wait() (a deadlock).
+        self._stopping = False
         self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
         # Like a one-wire half-duplex adapter: every byte the client sends comes back to it before any reply.
         self.echo = False
@@ -91,7 +93,7 @@ class Simulator(Engine):
     def serve(self, fd: int) -> None:
         """Answer requests read from `fd` until stop(); replies are written at their time (no polling)."""
         sends = bool(self.spec.sends)
-        while not self._stop.is_set():
+        while not self._stopping:
             if sends:
                 for when, frame in self.due():
                     self._seq += 1
@@ -118,7 +120,7 @@ class Simulator(Engine):
                 except OSError:  # the other side closed (EIO on a pty): wait for a new peer
                     data = b""
                 if not data:
-                    self._stop.wait(0.01)
+                    time.sleep(0.01)
                     continue
                 if self.tap is not None:
                     self.tap("request", data)
@@ -131,7 +133,7 @@ class Simulator(Engine):
                     heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))
 
     def stop(self) -> None:
-        self._stop.set()
+        self._stopping = True
         if not self._released:
             os.write(self._wake_w, b"x")
 

@@ -64,83 +64,82 @@ def fields_values(
 ) -> st.SearchStrategy[dict[str, Any]]:
     """Values of `fields`; sizes and counts given by a field stay within that field's range (`outer`: the fields
     of the enclosing message, for a group's items sized by one of them)."""
-    scope = {**(outer or {}), **{f.name: f for f in fields}}
+    return _fields_values(fields, rest_budget, {**(outer or {}), **{f.name: f for f in fields}})
 
-    @st.composite
-    def build(draw: st.DrawFn) -> dict[str, Any]:
-        values: dict[str, Any] = {}
-        sizes: dict[str, int] = {}
-        for f in fields:
-            if isinstance(f, Scalar):
-                if f.hidden:
-                    continue
-                values[f.name] = draw(scalar_value(f))
-            elif isinstance(f, Array):
-                values[f.name] = draw(
-                    st.lists(number(f.item, f.minimum, f.maximum), min_size=f.count, max_size=f.count)
-                )
-            elif isinstance(f, Packed):
-                items = st.integers(int(f.minimum), int(f.maximum))
-                values[f.name] = draw(st.lists(items, min_size=f.count, max_size=f.count))
-            elif isinstance(f, Bytes):
-                if isinstance(f.size, int):
-                    size = f.size
-                elif f.size == "rest":
-                    size = draw(st.integers(0, rest_budget))
-                else:
-                    size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 6))))
-                values[f.name] = draw(st.binary(min_size=size, max_size=size)).hex(" ")
-            elif isinstance(f, List):
-                values[f.name] = draw(list_value(f, fields, scope))
-            elif isinstance(f, Text):
-                if isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
-                    text = draw(st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=f.size))
-                    values[f.name] = text.rstrip(chr(f.pad))
-                elif isinstance(f.size, int):
-                    values[f.name] = draw(
-                        st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=f.size, max_size=f.size)
-                    )
-                elif isinstance(f.size, str) and f.size != "rest":  # sized by a field: within its range
-                    size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 12))))
-                    values[f.name] = draw(
-                        st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=size, max_size=size)
-                    )
-                else:
-                    values[f.name] = draw(TEXT)
-            elif isinstance(f, Group):
-                if isinstance(f.count, int):
-                    count = f.count
-                else:
-                    most = MAX_ITEMS if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[1]
-                    least = 0 if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[0]
-                    count = draw(st.integers(least, most))
-                item = fields_values(f.fields, 0, scope)
-                items = []
-                for _ in range(count):
-                    items.append(draw(item))
-                # bytes sized by an outer field must have one size in every item
-                sized = [
-                    i.name for i in f.fields if isinstance(i, Bytes) and isinstance(i.size, str) and i.size != "rest"
-                ]
-                for name in sized:
-                    for it in items[1:]:
-                        it[name] = items[0][name] if len(it[name]) != len(items[0][name]) else it[name]
-                values[f.name] = items
-            elif isinstance(f, TableValue):
-                entries = [e for e in f.table.entries if not e.reserved]
-                key = values.get(f.key)
-                entry = f.table.entry(key) if isinstance(key, int) else None
-                if entry is None or entry.reserved:
-                    entry = draw(st.sampled_from(entries))
-                    values[f.key] = entry.key
-                values[f.name] = draw(number(entry.type, entry.minimum, entry.maximum))
-            elif isinstance(f, TableBlock):
-                values[f.name] = draw(
-                    st.fixed_dictionaries({e.name: number(e.type, e.minimum, e.maximum) for e in f.entries})
-                )
-        return values
 
-    return build()
+# Decorated once, here: hypothesis reads a composite function's source when it decorates it (30 ms a time), which
+# a decorator inside fields_values paid for every message a test drew
+@st.composite
+def _fields_values(
+    draw: st.DrawFn, fields: tuple[Field, ...], rest_budget: int, scope: Mapping[str, Field]
+) -> dict[str, Any]:
+    values: dict[str, Any] = {}
+    sizes: dict[str, int] = {}
+    for f in fields:
+        if isinstance(f, Scalar):
+            if f.hidden:
+                continue
+            values[f.name] = draw(scalar_value(f))
+        elif isinstance(f, Array):
+            values[f.name] = draw(st.lists(number(f.item, f.minimum, f.maximum), min_size=f.count, max_size=f.count))
+        elif isinstance(f, Packed):
+            items = st.integers(int(f.minimum), int(f.maximum))
+            values[f.name] = draw(st.lists(items, min_size=f.count, max_size=f.count))
+        elif isinstance(f, Bytes):
+            if isinstance(f.size, int):
+                size = f.size
+            elif f.size == "rest":
+                size = draw(st.integers(0, rest_budget))
+            else:
+                size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 6))))
+            values[f.name] = draw(st.binary(min_size=size, max_size=size)).hex(" ")
+        elif isinstance(f, List):
+            values[f.name] = draw(list_value(f, fields, scope))
+        elif isinstance(f, Text):
+            if isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
+                text = draw(st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=f.size))
+                values[f.name] = text.rstrip(chr(f.pad))
+            elif isinstance(f.size, int):
+                values[f.name] = draw(
+                    st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=f.size, max_size=f.size)
+                )
+            elif isinstance(f.size, str) and f.size != "rest":  # sized by a field: within its range
+                size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 12))))
+                values[f.name] = draw(
+                    st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=size, max_size=size)
+                )
+            else:
+                values[f.name] = draw(TEXT)
+        elif isinstance(f, Group):
+            if isinstance(f.count, int):
+                count = f.count
+            else:
+                most = MAX_ITEMS if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[1]
+                least = 0 if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[0]
+                count = draw(st.integers(least, most))
+            item = fields_values(f.fields, 0, scope)
+            items = []
+            for _ in range(count):
+                items.append(draw(item))
+            # bytes sized by an outer field must have one size in every item
+            sized = [i.name for i in f.fields if isinstance(i, Bytes) and isinstance(i.size, str) and i.size != "rest"]
+            for name in sized:
+                for it in items[1:]:
+                    it[name] = items[0][name] if len(it[name]) != len(items[0][name]) else it[name]
+            values[f.name] = items
+        elif isinstance(f, TableValue):
+            entries = [e for e in f.table.entries if not e.reserved]
+            key = values.get(f.key)
+            entry = f.table.entry(key) if isinstance(key, int) else None
+            if entry is None or entry.reserved:
+                entry = draw(st.sampled_from(entries))
+                values[f.key] = entry.key
+            values[f.name] = draw(number(entry.type, entry.minimum, entry.maximum))
+        elif isinstance(f, TableBlock):
+            values[f.name] = draw(
+                st.fixed_dictionaries({e.name: number(e.type, e.minimum, e.maximum) for e in f.entries})
+            )
+    return values
 
 
 def list_value(

@@ -77,14 +77,15 @@ def random_frames(g: Generated, spec: Message, count: int) -> list[bytes]:
 
 def frame_pool(g: Generated, direction: Direction, awaited: str = "") -> Pool:
     """The spec's example frames and about POOL_SIZE frames of random valid messages of every type (`awaited`: of
-    that reply class alone, where replies are read with their request)."""
+    that reply class alone, where replies are read with their request: its share of POOL_SIZE)."""
     return _frame_pool(g.protocol.name, direction, awaited)
 
 
 @functools.cache
 def _frame_pool(protocol: str, direction: Direction, awaited: str) -> Pool:
     g = next(g for g in ALL if g.protocol.name == protocol)
-    specs = [m for m in g.protocol.messages() if m.direction == direction and awaited in ("", m.class_name)]
+    every = [m for m in g.protocol.messages() if m.direction == direction]
+    specs = [m for m in every if awaited in ("", m.class_name)]
     pool: Pool = []
     for spec in specs:
         layout = g.protocol.layout(spec)
@@ -94,7 +95,7 @@ def _frame_pool(protocol: str, direction: Direction, awaited: str) -> Pool:
                 for e in g.protocol.examples
                 if e.direction == direction and e.command == spec.command and e.subcommand == spec.subcommand
             ]
-        pool += [(frame, layout) for frame in random_frames(g, spec, max(4, POOL_SIZE // len(specs)))]
+        pool += [(frame, layout) for frame in random_frames(g, spec, max(4, POOL_SIZE // len(every)))]
     # frames no checksum protects (RoboClaw's read requests, address and command alone) turn up inside others: the
     # parser rightly takes such a frame first, and the frame around it is no intact frame of the stream
     if any(not checksums(layout) for _, layout in pool):

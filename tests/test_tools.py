@@ -121,9 +121,10 @@ def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
 def test_scan_finds_devices_set_to_another_rate_at_that_rate_alone() -> None:
     # `sim --baudrate N` hears only a line set to N (250000: not a termios B-constant, set through termios2), as
     # servos set to that rate do: the scan over the spec's seven rates finds both servos at 250000 and nowhere else
+    # (their two ids alone: each id that stays silent costs the scan's 0.3 s at each rate)
     with serve("fashionstar_uart.yaml", 2, 5, options=["--baudrate", "250000"]) as port:
-        every = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6", "--all-baudrates", "--json")
-        default = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6")
+        every = scan(spec("fashionstar_uart"), "--port", port, "--ids", "2,5", "--all-baudrates", "--json")
+        default = scan(spec("fashionstar_uart"), "--port", port, "--ids", "2,5")
     found = [(d["id"], d["baudrate"]) for d in map(json.loads, every.stdout.splitlines())]
     assert found == [(2, 250000), (5, 250000)]
     assert (default.returncode, default.stdout) == (1, "")

@@ -49,20 +49,17 @@ class Generated:
     structs: ModuleType
 
 
-def load(spec: Path) -> Generated:
-    protocol = load_protocol(str(spec), str(spec.relative_to(ROOT)))
+def load(protocol: Protocol) -> Generated:
     package = importlib.import_module(f"{SHIPPED}.{protocol.name}")
     structs = importlib.import_module(f"{SHIPPED}.{protocol.name}.structs")
     return Generated(protocol, package, structs)
 
 
-def is_text(spec: Path) -> bool:
-    """A text protocol (`framing: {kind: text}`): tests/test_text_frames.py covers it, not the binary suites."""
-    return load_protocol(str(spec), str(spec.relative_to(ROOT))).text is not None
-
-
-TEXT_SPECS = [spec for spec in SPECS if is_text(spec)]
-ALL = [load(spec) for spec in SPECS if spec not in TEXT_SPECS]
+# each shipped spec loaded once: text protocols (`framing: {kind: text}`) are tests/test_text_frames.py's, the rest
+# the binary suites'
+_LOADED = [(spec, load_protocol(str(spec), str(spec.relative_to(ROOT)))) for spec in SPECS]
+TEXT_SPECS = [spec for spec, protocol in _LOADED if protocol.text is not None]
+ALL = [load(protocol) for _, protocol in _LOADED if protocol.text is None]
 
 
 def by_protocol(items: list[tuple[Generated, object]]) -> list[object]:

@@ -27,7 +27,6 @@ from conftest import (
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from serialspec.backends import Unsupported
 from serialspec.backends.c import length_byte
 from serialspec.backends.c.build import files as c_files
 from serialspec.lang.model import Direction, Message
@@ -67,11 +66,9 @@ GENERATED_C = ROOT / "generated" / "c"
 
 
 def supported(g: Generated) -> bool:
-    try:
-        c_files(g.protocol)
-    except Unsupported:
-        return False
-    return True
+    """The C target takes the spec: `serialspec generate` wrote its C (`make test` checks first that generated/ is
+    what the generator writes; generating every spec's C again here cost each test process 3 s)."""
+    return (GENERATED_C / g.protocol.name).is_dir()
 
 
 C_SPECS = [g for g in ALL if supported(g)]

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from conftest import ALL, ROOT, Generated, encode, example_request
-from serialspec.cli import main
+from serialspec.cli import main, plain_decode
 
 FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
 #: The repository's [tool.serialspec] namespace settings, for a copy of its specs and generated/ elsewhere.
@@ -48,6 +48,49 @@ def test_decode_rotate_as_json_then_encode_gives_the_same_bytes() -> None:
 def test_decode_accepts_the_hex_forms_people_paste(form: str) -> None:
     result = serialspec("decode", FS, form, "--json")
     assert json.loads(result.stdout)["command"] == "ping"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["decode", "feetech_sms", "ff ff 01 02 01 fb"],
+        ["decode", "feetech_sms", "ff ff", "01 02", "--direction", "request", "--json"],
+        ["decode", "--json", "feetech_sms", "--direction=response", "ff ff"],
+    ],
+)
+def test_a_plain_decode_command_line_is_read_as_argparse_reads_it(argv: list[str]) -> None:
+    """`decode SPEC HEX... [--direction D] [--json]` is read without argparse (start-up time): to the same arguments."""
+    from serialspec.cli.arguments import parse
+
+    plain = plain_decode(argv)
+    assert plain is not None and vars(plain) == vars(parse(argv))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["decode", "x", "-"],
+        ["decode", "x", "ff", "--dir", "request"],
+        ["decode", "x", "ff", "--direction", "up"],
+        ["decode", "x", "ff", "--direction"],
+        ["decode", "x", "ff", "--units"],
+        ["decode", "x", "ff", "--json", "--json"],
+        ["decode", "x", "ff", "-h"],
+        ["decode", "x"],
+        ["encode", "x", "ff"],
+    ],
+)
+def test_any_other_command_line_is_left_to_argparse(argv: list[str]) -> None:
+    assert plain_decode(argv) is None
+
+
+def test_list_and_bit_field_values_are_shown_as_json_writes_them() -> None:
+    """decode writes plain values itself (no json import at start-up), and leaves anything else to json."""
+    from serialspec.cli.decode import _json
+
+    values = [[], [1, -2, 2**70], {"a": 1, "b": None, "c": True}, ["é", 'q"', "t\tab"], [1.5, float("nan")], {1: [0]}]
+    for value in values:
+        assert _json(value) == json.dumps(value, ensure_ascii=False)
 
 
 @pytest.mark.parametrize(

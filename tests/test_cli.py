@@ -302,6 +302,10 @@ def test_a_reference_links_its_spec_from_wherever_it_is_generated(tmp_path: Path
     link = re.search(r"spec: \[`tinylamp\.yaml`\]\(([^)]+)\)", page.read_text(encoding="utf-8"))
     assert link is not None
     assert (page.parent / link[1]).resolve() == (tmp_path / "tinylamp.yaml").resolve()
+    if out == "src":  # a project whose packages go to src/: `decode NAME` found no package NAME/ in its folder
+        (tmp_path / "pyproject.toml").write_text('[tool.serialspec]\nout = "src"\n', encoding="utf-8")
+        decoded = serialspec("decode", "tinylamp", "aa 02 04 01 32 c8 00 ab", "--direction", "request", cwd=tmp_path)
+        assert decoded.stdout.startswith("tinylamp request set_brightness"), decoded.stderr
 
 
 def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_nothing(tmp_path: Path) -> None:

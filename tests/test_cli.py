@@ -335,6 +335,23 @@ def test_check_of_a_spec_of_ones_own_names_the_generate_that_brings_it_up_to_dat
     assert serialspec("check", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
 
 
+def test_an_output_folder_outside_the_project_is_shown_as_it_was_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`check ../lamp.yaml --out ../gen` from a folder beside them listed `/abs/path/gen/tinylamp/codec.py: stale`
+    (and a spec.yaml there as an installed package's): the paths are shown as the user named the folder."""
+    from serialspec.cli.project import project
+
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    proj = project(None, ["../lamp.yaml"], "../gen")
+    assert proj.display(proj.out) == "../gen"
+    assert proj.display(proj.out / "tinylamp" / "codec.py") == "../gen/tinylamp/codec.py"
+    (proj.out / "tinylamp").mkdir(parents=True)
+    (proj.out / "tinylamp" / "__init__.py").touch()
+    assert proj.display(proj.out / "tinylamp" / "spec.yaml") == "../gen/tinylamp/spec.yaml"
+
+
 def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path) -> None:
     """`generate --target c --out DIR` writes DIR/<protocol>/ (as the Python target writes DIR/<protocol>/), not the
     DIR/c/<protocol>/ the project's generated/ holds beside the Python packages."""

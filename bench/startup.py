@@ -170,10 +170,15 @@ def run() -> Table:
             "serial settings and stream frame formats are plain classes; the frame engine's layouts, checksum "
             "algorithms, frame transforms and text messages are frozen value classes (serialspec.runtime.values) "
             "whose __init__ is not compiled per class; a 16-bit CRC goes byte by byte before it builds its "
-            "65,536-entry word table (after 64 KiB). A spec file (or --units, --request, --file) takes the resolved "
-            "model from serialspec's cache. The parser is built for the chosen verb alone (`--help` builds none of "
-            "the verbs' parsers), argparse's texts looked up in gettext's catalogue once.",
-            "What is left is mostly Python's own: `import argparse` (with re, enum, gettext and locale) costs about "
-            "1.8× a bare start by itself, so --help within 2× would need a top-level command line without argparse.",
+            "65,536-entry word table (after 64 KiB), any other CRC goes bit by bit before it builds its 256-entry "
+            "table (after 256 bytes); a codec imports its frame transform from the transform's module alone. "
+            "`decode NAME HEX... [--direction D] [--json]` is read without argparse and writes list and bit-field "
+            "values without json; hex and text fields are checked without regular expressions. A spec file (or "
+            "--units, --request, --file) takes the resolved model from serialspec's cache. Other command lines go "
+            "through argparse, its parser built for the chosen verb alone (`--help` builds none of the verbs' "
+            "parsers), its texts looked up in gettext's catalogue once.",
+            "What is left is mostly Python's own: pip's `serialspec` script imports re (with enum, functools and "
+            "collections) before serialspec, and `import argparse` (with gettext) costs about 1.8× a bare start by "
+            "itself with that, so --help within 2× would need a top-level command line without argparse.",
         ],
     )

@@ -394,7 +394,8 @@ def test_decode_of_every_shipped_package_imports_neither_the_model_nor_dataclass
     """`decode PACKAGE HEX` of every shipped protocol (byte framings, COBS, escaping, optional elements, hex-ASCII,
     text) answers from the generated package alone, as bench/startup.py times it: in one fresh process, after each
     decode, none of the heavy modules (the model, the language, YAML, dataclasses, inspect, typing, pkgutil, pickle)
-    has been imported."""
+    has been imported, nor argparse (the command line `decode NAME HEX --direction D` is read without it) or json
+    (list and bit-field values are written without it)."""
     frames = shipped_frames()
     code = (
         "import contextlib, io, sys\n"
@@ -404,7 +405,7 @@ def test_decode_of_every_shipped_package_imports_neither_the_model_nor_dataclass
         "    with contextlib.redirect_stdout(out):\n"
         "        code = main(['decode', name, frame, '--direction', direction])\n"
         "    heavy = sorted(m for m in sys.modules if m in ('yaml', 'serialspec.lang.resolve', "
-        "'serialspec.lang.model', 'dataclasses', 'inspect', 'typing', 'pkgutil', 'pickle'))\n"
+        "'serialspec.lang.model', 'dataclasses', 'inspect', 'typing', 'pkgutil', 'pickle', 'argparse', 'json'))\n"
         "    print(name, code, out.getvalue().split()[:2], heavy)\n"
     )
     env = {"SERIALSPEC_CACHE_DIR": str(tmp_path / "cache"), "PATH": ""}

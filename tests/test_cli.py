@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from conftest import ALL, ROOT, Generated, encode, example_request
-from serialspec.cli import main
+from serialspec.cli import main, plain_decode
 
 FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
 #: The repository's [tool.serialspec] namespace settings, for a copy of its specs and generated/ elsewhere.
@@ -48,6 +48,49 @@ def test_decode_rotate_as_json_then_encode_gives_the_same_bytes() -> None:
 def test_decode_accepts_the_hex_forms_people_paste(form: str) -> None:
     result = serialspec("decode", FS, form, "--json")
     assert json.loads(result.stdout)["command"] == "ping"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["decode", "feetech_sms", "ff ff 01 02 01 fb"],
+        ["decode", "feetech_sms", "ff ff", "01 02", "--direction", "request", "--json"],
+        ["decode", "--json", "feetech_sms", "--direction=response", "ff ff"],
+    ],
+)
+def test_a_plain_decode_command_line_is_read_as_argparse_reads_it(argv: list[str]) -> None:
+    """`decode SPEC HEX... [--direction D] [--json]` is read without argparse (start-up time): to the same arguments."""
+    from serialspec.cli.arguments import parse
+
+    plain = plain_decode(argv)
+    assert plain is not None and vars(plain) == vars(parse(argv))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["decode", "x", "-"],
+        ["decode", "x", "ff", "--dir", "request"],
+        ["decode", "x", "ff", "--direction", "up"],
+        ["decode", "x", "ff", "--direction"],
+        ["decode", "x", "ff", "--units"],
+        ["decode", "x", "ff", "--json", "--json"],
+        ["decode", "x", "ff", "-h"],
+        ["decode", "x"],
+        ["encode", "x", "ff"],
+    ],
+)
+def test_any_other_command_line_is_left_to_argparse(argv: list[str]) -> None:
+    assert plain_decode(argv) is None
+
+
+def test_list_and_bit_field_values_are_shown_as_json_writes_them() -> None:
+    """decode writes plain values itself (no json import at start-up), and leaves anything else to json."""
+    from serialspec.cli.decode import _json
+
+    values = [[], [1, -2, 2**70], {"a": 1, "b": None, "c": True}, ["é", 'q"', "t\tab"], [1.5, float("nan")], {1: [0]}]
+    for value in values:
+        assert _json(value) == json.dumps(value, ensure_ascii=False)
 
 
 @pytest.mark.parametrize(
@@ -259,6 +302,10 @@ def test_a_reference_links_its_spec_from_wherever_it_is_generated(tmp_path: Path
     link = re.search(r"spec: \[`tinylamp\.yaml`\]\(([^)]+)\)", page.read_text(encoding="utf-8"))
     assert link is not None
     assert (page.parent / link[1]).resolve() == (tmp_path / "tinylamp.yaml").resolve()
+    if out == "src":  # a project whose packages go to src/: `decode NAME` found no package NAME/ in its folder
+        (tmp_path / "pyproject.toml").write_text('[tool.serialspec]\nout = "src"\n', encoding="utf-8")
+        decoded = serialspec("decode", "tinylamp", "aa 02 04 01 32 c8 00 ab", "--direction", "request", cwd=tmp_path)
+        assert decoded.stdout.startswith("tinylamp request set_brightness"), decoded.stderr
 
 
 def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_nothing(tmp_path: Path) -> None:
@@ -286,6 +333,23 @@ def test_check_of_a_spec_of_ones_own_names_the_generate_that_brings_it_up_to_dat
     assert hint == "run `serialspec generate 'my lamp.yaml' --out .` to bring the generated files up to date"
     assert serialspec("generate", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
     assert serialspec("check", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
+
+
+def test_an_output_folder_outside_the_project_is_shown_as_it_was_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`check ../lamp.yaml --out ../gen` from a folder beside them listed `/abs/path/gen/tinylamp/codec.py: stale`
+    (and a spec.yaml there as an installed package's): the paths are shown as the user named the folder."""
+    from serialspec.cli.project import project
+
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    proj = project(None, ["../lamp.yaml"], "../gen")
+    assert proj.display(proj.out) == "../gen"
+    assert proj.display(proj.out / "tinylamp" / "codec.py") == "../gen/tinylamp/codec.py"
+    (proj.out / "tinylamp").mkdir(parents=True)
+    (proj.out / "tinylamp" / "__init__.py").touch()
+    assert proj.display(proj.out / "tinylamp" / "spec.yaml") == "../gen/tinylamp/spec.yaml"
 
 
 def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path) -> None:

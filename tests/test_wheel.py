@@ -196,7 +196,9 @@ def test_a_shipped_protocol_decodes_by_name(user: User) -> None:
     missing = user.serialspec("decode", "no_such_protocol", "00", check=False)
     assert (
         missing.returncode == 1
-        and "no such spec file, nor a protocol package no_such_protocol/ in this folder or installed" in missing.stderr
+        and "no such spec file, nor a protocol package no_such_protocol/ in this folder, the project's output folder "
+        "or installed"
+        in missing.stderr
     )
 
 

@@ -10,10 +10,11 @@ from serialspec.checksums.crc import crc_function
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency
+from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
+from serialspec.transforms.replace import Transparency
 
 from .messages import (
     ActionRequest,

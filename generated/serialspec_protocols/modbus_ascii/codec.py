@@ -10,13 +10,14 @@ from serialspec.checksums.sum import sum_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, HexAscii, Layout, SizeRule
+from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, Layout, SizeRule
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.packing import pack_bits as _pack_bits
 from serialspec.runtime.packing import unpack_bits as _unpack_bits
 from serialspec.runtime.packing import unpack_runs as _unpack_runs
+from serialspec.transforms.hexascii import HexAscii
 
 from .messages import (
     CoilState,

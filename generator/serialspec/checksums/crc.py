@@ -83,28 +83,68 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     return _crc_bytes(width, poly, init, refin, refout, xorout)
 
 
+# A CRC goes bit by bit (no table) until it has been fed this many bytes, then builds its 256-entry table: the table
+# takes as many steps as the bit loop over this many bytes, so a command that checks one frame (`serialspec decode`)
+# does not pay for it, and a stream pays at most about twice what the table saves.
+_TABLE_AFTER = 256
+
+
 def _crc_bytes(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
-    """The CRC as a loop over the bytes through the 256-entry table."""
+    """The CRC as a loop over the bytes through the 256-entry table (bit by bit until the table is made)."""
     mask = (1 << width) - 1
-    table = crc_table(width, poly, refin)
+    table: tuple[int, ...] = ()
+    fed = 0
     if refin:
         start = _reflect(init, width)
+        reflected_poly = _reflect(poly, width)
 
-        def crc(data: bytes) -> int:
+        def bits(data: bytes) -> int:
             value = start
             for byte in data:
-                value = table[(value ^ byte) & 0xFF] ^ (value >> 8)
+                value ^= byte
+                for _ in range(8):
+                    value = (value >> 1) ^ reflected_poly if value & 1 else value >> 1
+            return value
+
+        def crc(data: bytes) -> int:
+            nonlocal table, fed
+            if table:
+                value = start
+                for byte in data:
+                    value = table[(value ^ byte) & 0xFF] ^ (value >> 8)
+            else:
+                fed += len(data)
+                value = bits(data)
+                if fed >= _TABLE_AFTER:
+                    table = crc_table(width, poly, refin)
             if not refout:
                 value = _reflect(value, width)
             return (value ^ xorout) & mask
 
     else:
         shift = width - 8
+        top = 1 << (width - 1)
 
-        def crc(data: bytes) -> int:
+        def bits(data: bytes) -> int:
             value = init
             for byte in data:
-                value = table[((value >> shift) ^ byte) & 0xFF] ^ ((value << 8) & mask)
+                value ^= byte << shift
+                for _ in range(8):
+                    value = ((value << 1) ^ poly) if value & top else value << 1
+                value &= mask
+            return value
+
+        def crc(data: bytes) -> int:
+            nonlocal table, fed
+            if table:
+                value = init
+                for byte in data:
+                    value = table[((value >> shift) ^ byte) & 0xFF] ^ ((value << 8) & mask)
+            else:
+                fed += len(data)
+                value = bits(data)
+                if fed >= _TABLE_AFTER:
+                    table = crc_table(width, poly, refin)
             if refout:
                 value = _reflect(value, width)
             return (value ^ xorout) & mask
@@ -153,7 +193,7 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
     (the bytes as one word, low byte first when reflected), from a 65,536-entry table made once it has been fed
     _WORDS_AFTER bytes (a few milliseconds, not paid by an import, shared by every CRC of that polynomial; until
     then it goes byte by byte); an odd last byte goes through the 256-entry table."""
-    table = crc_table(16, poly, refin)
+    table: tuple[int, ...] = ()  # the 256-entry table, for an odd last byte once the word table is made
     by_bytes = _crc_bytes(16, poly, init, refin, refout, xorout)
     fed = 0
     order = "<" if refin else ">"
@@ -167,12 +207,12 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
         return (_reflect(value, 16) if refin != refout else value) ^ xorout
 
     def crc(data: bytes) -> int:
-        nonlocal pairs, unpack, fed
+        nonlocal pairs, unpack, fed, table
         if not pairs:
             fed += len(data)
             if fed < _WORDS_AFTER:
                 return by_bytes(data)
-            pairs, unpack = _word_table(poly, refin), _unpack_words(order)
+            pairs, unpack, table = _word_table(poly, refin), _unpack_words(order), crc_table(16, poly, refin)
         value = start
         n = len(data)
         for word in unpack[n >> 1](data) if n < longest else struct.unpack_from(f"{order}{n >> 1}H", data):

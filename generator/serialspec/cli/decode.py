@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 from collections.abc import Callable
@@ -14,6 +13,7 @@ from serialspec.runtime.hexbytes import parse_hex
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
+    import argparse
     from typing import Any
 
     from serialspec.cli.frames import Seen
@@ -298,7 +298,40 @@ def _value(value: Any) -> str:
     if isinstance(value, list) and type(value) is not list:  # views.FlagNames (--units): the flags' names as words
         return str(value)
     if isinstance(value, dict | list):
-        import json
-
-        return json.dumps(value, ensure_ascii=False)
+        return _json(value)
     return str(value)
+
+
+def _json(value: Any) -> str:
+    """json.dumps(value, ensure_ascii=False): lists and objects of plain integers, names and null (list fields, bit
+    fields) written here, the json module imported for anything else (importing it is a tenth of the start of
+    `decode PACKAGE HEX`, bench/startup.py)."""
+    written = _plain_json(value)
+    if written is not None:
+        return written
+    import json
+
+    return json.dumps(value, ensure_ascii=False)
+
+
+def _plain_json(value: Any) -> str | None:
+    """What json.dumps(value, ensure_ascii=False) writes, for integers, booleans, None, strings without a character
+    it escapes, and lists and str-keyed dicts of them; None for anything else."""
+    kind = type(value)
+    if kind is int:
+        return str(value)
+    if kind is str:
+        plain = '"' not in value and "\\" not in value and all(c >= " " for c in value)
+        return f'"{value}"' if plain else None
+    if value is None or kind is bool:
+        return "null" if value is None else "true" if value else "false"
+    if kind is list:
+        items = [_plain_json(item) for item in value]
+        return None if None in items else "[" + ", ".join(items) + "]"  # type: ignore[arg-type]
+    if kind is dict:
+        keys = [_plain_json(key) if type(key) is str else None for key in value]
+        items = [_plain_json(item) for item in value.values()]
+        if None in keys or None in items:
+            return None
+        return "{" + ", ".join(f"{key}: {item}" for key, item in zip(keys, items, strict=True)) + "}"
+    return None

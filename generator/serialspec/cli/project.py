@@ -52,6 +52,7 @@ class Project:
     namespace: str = ""  # the package every protocol package sits in ("" for top-level packages)
     #: With a namespace: protocols whose top-level name gets a module aliasing the package ("*": every one).
     old_names: frozenset[str] = frozenset()
+    given_out: str = ""  # the output folder as named on the command line (--out), if it was
 
     def package_folder(self, name: str) -> str:
         """Where a generated package's files go, relative to the output folder."""
@@ -61,6 +62,9 @@ class Project:
         """A path as people read it: relative to the project root where possible."""
         if path.is_absolute() and path.is_relative_to(self.root):
             return os.path.relpath(path, self.root)
+        if self.given_out and path.is_absolute() and path.is_relative_to(self.out):  # --out outside the project
+            inside = os.path.relpath(path, self.out)
+            return self.given_out if inside == "." else os.path.join(self.given_out, inside)
         if path.name == SHIPPED_SPEC and (path.parent / "__init__.py").is_file():  # an installed package's spec
             return f"{path.parent.name}/{SHIPPED_SPEC}"
         return str(path)
@@ -131,6 +135,7 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         bool(specs),
         namespace,
         _old_names(config.get("old_names", False)) if namespace else frozenset(),
+        out or "",
     )
 
 

@@ -15,7 +15,6 @@ minutes), and a sentence remembers how many fields it had (trailing empty fields
 from __future__ import annotations
 
 import datetime
-import re
 from collections.abc import AsyncIterator, Callable, Generator, Iterable, Iterator, Mapping
 from decimal import Decimal, InvalidOperation
 from enum import Enum
@@ -264,7 +263,7 @@ class TextFraming:
                 raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
             return body
         written, covered = body[at + len(self.marker) :], body[:at]
-        if len(written) != self.digits or not re.fullmatch(r"[0-9A-Fa-f]+", written):
+        if len(written) != self.digits or not written or any(c not in _HEX_DIGITS for c in written):
             raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
         computed = self.checksum(covered.encode("ascii"))
         if int(written, 16) != computed:
@@ -314,10 +313,15 @@ class TextFraming:
 
 # --- fields -------------------------------------------------------------------------------------------------------
 
-_DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)")
-_INTEGER = re.compile(r"[+-]?\d+")
-_TIME = re.compile(r"(\d\d)(\d\d)(\d\d)(?:\.(\d*))?")
-_DATE = re.compile(r"(\d\d)(\d\d)(\d\d)")
+# The fields' forms are checked with str methods, not regular expressions: compiling one costs more than decoding
+# a sentence, and `serialspec decode PACKAGE SENTENCE` would compile each on every start. A digit is what \d matches
+# (str.isdecimal: any Unicode decimal digit, as int() and Decimal() read them).
+_HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
+
+
+def _unsigned(text: str) -> str:
+    """The text after one leading sign."""
+    return text[1:] if text[:1] in ("+", "-") else text
 
 
 def _split(text: str, by: str) -> list[str]:
@@ -413,23 +417,27 @@ def decode_field(where: str, spec: TextField, text: str) -> Any:
 
 
 def _decimal(spec: TextField, text: str) -> Fixed:
-    if not _DECIMAL.fullmatch(text):
+    whole, dot, fraction = _unsigned(text).partition(".")  # [+-]?(\d+\.?\d*|\.\d+)
+    if not (whole.isdecimal() or not whole and dot and fraction) or fraction and not fraction.isdecimal():
         raise ValueError(text)
     return Fixed(text)
 
 
 def _integer(spec: TextField, text: str) -> int:
-    if not _INTEGER.fullmatch(text):
+    if not _unsigned(text).isdecimal():  # [+-]?\d+
         raise ValueError(text)
     return int(text)
 
 
 def _angle(spec: TextField, text: str) -> Angle:
     width = spec.width or 2
-    match = re.fullmatch(rf"(\d{{1,{width}}})(\d\d(?:\.\d*)?)", text)
-    if not match or Decimal(match[2]) >= 60:
+    head, dot, fraction = text.partition(".")  # (\d{1,width})(\d\d(?:\.\d*)?): degrees, then minutes
+    if not (3 <= len(head) <= width + 2 and head.isdecimal()) or fraction and not fraction.isdecimal():
         raise ValueError(text)
-    return Angle(int(match[1]), Decimal(match[2]))
+    minutes = Decimal(head[-2:] + dot + fraction)
+    if minutes >= 60:
+        raise ValueError(text)
+    return Angle(int(head[:-2]), minutes)
 
 
 def _char(spec: TextField, text: str) -> Any:
@@ -443,16 +451,15 @@ def _text(spec: TextField, text: str) -> str:
 
 
 def _time(spec: TextField, text: str) -> Clock:
-    match = _TIME.fullmatch(text)
-    if not match:
+    head, _, fraction = text.partition(".")  # (\d\d)(\d\d)(\d\d)(?:\.(\d*))?
+    if not (len(head) == 6 and head.isdecimal()) or fraction and not fraction.isdecimal():
         raise ValueError(text)
-    fraction = match[4] or ""
     micro = int((fraction + "000000")[:6]) if fraction else 0
-    return Clock(int(match[1]), int(match[2]), int(match[3]), micro, len(fraction))
+    return Clock(int(head[:2]), int(head[2:4]), int(head[4:]), micro, len(fraction))
 
 
 def _date(spec: TextField, text: str) -> datetime.date:
-    if not _DATE.fullmatch(text):
+    if not (len(text) == 6 and text.isdecimal()):  # (\d\d)(\d\d)(\d\d)
         raise ValueError(text)
     return datetime.datetime.strptime(text, "%d%m%y").date()
 

@@ -4,7 +4,8 @@ A transform rewrites the bytes of a span of frame elements on the wire (`framing
 stuffing or escaping (`method: replace`, DYNAMIXEL, SLIP, XBee API mode 2), COBS (`method: cobs`). `transforms()`
 finds them: it imports every module of this package and collects the Transform subclasses that set `name`, so a new
 transform is a new module and nothing else. The package imports nothing of the generator: generated code imports
-each transform's runtime class (through serialspec.runtime.framing), and the runtime wheel ships the package.
+each transform's runtime class (a codec from the transform's module, so it imports no other transform; structs.py
+through serialspec.runtime.framing), and the runtime wheel ships the package.
 """
 
 from __future__ import annotations

@@ -113,7 +113,7 @@ class Transform:
 
     name: ClassVar[str]  # the `method:` value
     summary: ClassVar[str]  # what it does, for the grammar's description of `method`
-    runtime_name: ClassVar[str]  # the runtime class's name (generated code imports it from runtime.framing)
+    runtime_name: ClassVar[str]  # the runtime class's name (generated code imports it by this name)
     keys: ClassVar[tuple[Key, ...]] = ()
     samples: ClassVar[tuple[Sample, ...]] = ()
 

@@ -26,6 +26,7 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
 )
+from serialspec.transforms import runtime_classes
 
 if TYPE_CHECKING:
     from serialspec.backends.python.content import PackageCode
@@ -121,6 +122,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     # the runtime.framing names the codec uses: the FrameCodecs' (the straight-line functions' Transparency objects are
     # those of the same layouts) and ERROR_REPLY where error replies are told by their flag
     names = {"EngineFormat"}
+    transform_classes = runtime_classes()
     for direction, layout in protocol.framing.layouts.items():
         table = direction_dispatch(protocol, direction)
         dispatchers += table.dispatchers
@@ -185,7 +187,11 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         if requesting
         else [],
         "reply_layouts": reply_layouts,
-        "framing_imports": sorted(names, key=import_order),
+        # a transform's runtime class from its own module (runtime.framing would import every transform to find it)
+        "framing_imports": sorted(names - set(transform_classes), key=import_order),
+        "transform_imports": sorted(
+            f"from {transform_classes[name][0]} import {name}" for name in names & set(transform_classes)
+        ),
         # the straight-line frame checks raise it (the engine raises its own)
         "checksum_error": any(
             element.kind == "checksum"

@@ -2109,6 +2109,23 @@ REQUEST_FORMAT = FrameFormat(
         0x1101: _run_reset_mturn_angle_request,
         0x1601: _run_monitor_request,
     },
+    units={
+        0x0101: (_S_XX2_U8_X.unpack_from, PingRequest),
+        0x0201: (_S_XX2_U8_X.unpack_from, ResetUserDataRequest),
+        0x0302: (_S_XX2_U8_U8_X.unpack_from, ReadDataRequest),
+        0x0501: (_S_XX2_U8_X.unpack_from, ReadBatchDataRequest),
+        0x0807: (_S_XX2_U8_I16_U16_U16_X.unpack_from, RotateRequest),
+        0x0903: (_S_XX2_U8_U16_X.unpack_from, DampingRequest),
+        0x0a01: (_S_XX2_U8_X.unpack_from, ReadAngleRequest),
+        0x0b0b: (_S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveByIntervalRequest),
+        0x0c0b: (_S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveByVelocityRequest),
+        0x0d0b: (_S_XX2_U8_I32_U32_U16_X.unpack_from, MoveMturnRequest),
+        0x0e0f: (_S_U8_I32_U32_U16_U16_U16_AFTER_HEADER.unpack_from, MoveMturnByIntervalRequest),
+        0x0f0d: (_S_U8_I32_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveMturnByVelocityRequest),
+        0x1001: (_S_XX2_U8_X.unpack_from, ReadMturnAngleRequest),
+        0x1101: (_S_XX2_U8_X.unpack_from, ResetMturnAngleRequest),
+        0x1601: (_S_XX2_U8_X.unpack_from, MonitorRequest),
+    },
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -2124,6 +2141,11 @@ RESPONSE_FORMAT = FrameFormat(
         0x0101: _run_ping_response,
         0x0a03: _run_read_angle_response,
         0x1007: _run_read_mturn_angle_response,
+    },
+    units={
+        0x0101: (_S_XX2_U8_X.unpack_from, PingResponse),
+        0x0a03: (_S_XX2_U8_I16_X.unpack_from, ReadAngleResponse),
+        0x1007: (_S_XX2_U8_I32_I16_X.unpack_from, ReadMturnAngleResponse),
     },
 )
 

@@ -521,6 +521,7 @@ def run_frames(
     return {
         "name": message_function("run", message),
         "build": code.build_all(cls, names, f"{frames}.iter_unpack(frames)"),
+        "unpack": f"{frames}.unpack_from",  # one such frame's values, from the bytes after its header
         "returns": cls,
         "where": f"{message.key} {message.direction.value}",
     }

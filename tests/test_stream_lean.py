@@ -196,3 +196,26 @@ def test_the_sieve_decides_a_read_of_frames_and_cut_frame_starts(monkeypatch: py
     assert found == fed(scanning(fs.StreamParser(Direction.RESPONSE)), [stream])
     assert found[0] == [fs.decode(r, Direction.RESPONSE) for r in replies[:3] + replies[5:39]]
     assert found[1] == (2, 2 + 5 + 8 + 2, replies[39][:6])  # (a header alone names no frame: no error)
+
+
+def test_whole_frames_of_a_run_key_are_checked_and_built_without_a_decoder_call(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The usual piece (a whole frame of a key whose frames are checked in runs) has its sum checked and its message
+    built by the loop itself, from the format's units: no decoder is called for it, corrupt or not."""
+    g, direction = next((g, d) for g, d in SIEVED if f"{g.protocol.name}:{d.value}" == "fashionstar_uart:response")
+    parser = g.package.StreamParser(direction)
+    current = parser._single
+
+    def refuse(*_: object) -> None:
+        raise AssertionError("a decoder was called for a whole frame of a run key")
+
+    lean = {key: (size, rest, refuse, unit) for key, (size, rest, _, unit) in current.lean.items() if unit is not None}
+    assert lean  # the run keys have units
+    monkeypatch.setattr(current, "lean", lean)
+    frames = one_key_frames(g, direction)[:3]
+    corrupt = frames[0][:-1] + bytes((frames[0][-1] ^ 0xFF,))
+    assert parser.feed(b"\x00" + b"".join(frames) + corrupt + b"\x07") == [
+        g.package.decode(f, direction) for f in frames
+    ]
+    assert (parser.errors, parser.garbage, parser.pending()) == (1, 1 + len(corrupt), b"\x07")

@@ -97,6 +97,7 @@ _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
 _S_READBATCHDATARESPONSE_SERVO_ID_IN_38 = struct.Struct('<4xBBBBBBBHHHHHHBBBBBBHhhh1x')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
+_S_U8_I16_IN_8 = struct.Struct('<4xBh1x')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
 _S_U8_I16_U16_U16_IN_12 = struct.Struct('<4xBhHH1x')
 _S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
@@ -114,11 +115,14 @@ _S_U8_I32_U32_U16_IN_16 = struct.Struct('<4xBiIH1x')
 _S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
 _S_U8_I32_U32_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBiIHHHx')
 _S_U8_I32_U32_U16_U16_U16_IN_20 = struct.Struct('<4xBiIHHH1x')
+_S_U8_IN_6 = struct.Struct('<4xB1x')
 _S_U8_U16 = struct.Struct('<BH')
+_S_U8_U16_IN_8 = struct.Struct('<4xBH1x')
 _S_U8_U16_U8 = struct.Struct('<BHB')
 _S_U8_U16_U8_IN_8 = struct.Struct('<4xBHB')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_IN_6 = struct.Struct('<4xBB')
+_S_U8_U8_IN_7 = struct.Struct('<4xBB1x')
 _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U16_U8 = struct.Struct('<BBHB')
@@ -1906,24 +1910,24 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 # The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
 # for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
 _REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes], tuple[int, ...]] | None, type[Message]]] = {
-    b'\x12L\x01\x01': (6, _whole_ping_request, None, Message),
-    b'\x12L\x02\x01': (6, _whole_reset_user_data_request, None, Message),
-    b'\x12L\x03\x02': (7, _whole_read_data_request, None, Message),
-    b'\x12L\x05\x01': (6, _whole_read_batch_data_request, None, Message),
+    b'\x12L\x01\x01': (6, _whole_ping_request, _S_U8_IN_6.unpack, PingRequest),
+    b'\x12L\x02\x01': (6, _whole_reset_user_data_request, _S_U8_IN_6.unpack, ResetUserDataRequest),
+    b'\x12L\x03\x02': (7, _whole_read_data_request, _S_U8_U8_IN_7.unpack, ReadDataRequest),
+    b'\x12L\x05\x01': (6, _whole_read_batch_data_request, _S_U8_IN_6.unpack, ReadBatchDataRequest),
     b'\x12L\x06!': (38, _whole_write_batch_data_request, None, Message),
     b'\x12L\x08\x07': (12, _whole_rotate_request, _S_U8_I16_U16_U16_IN_12.unpack, RotateRequest),
-    b'\x12L\t\x03': (8, _whole_damping_request, None, Message),
-    b'\x12L\n\x01': (6, _whole_read_angle_request, None, Message),
+    b'\x12L\t\x03': (8, _whole_damping_request, _S_U8_U16_IN_8.unpack, DampingRequest),
+    b'\x12L\n\x01': (6, _whole_read_angle_request, _S_U8_IN_6.unpack, ReadAngleRequest),
     b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack, MoveByIntervalRequest),
     b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack, MoveByVelocityRequest),
     b'\x12L\r\x0b': (16, _whole_move_mturn_request, _S_U8_I32_U32_U16_IN_16.unpack, MoveMturnRequest),
     b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request, _S_U8_I32_U32_U16_U16_U16_IN_20.unpack, MoveMturnByIntervalRequest),
     b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request, _S_U8_I32_U16_U16_U16_U16_IN_18.unpack, MoveMturnByVelocityRequest),
-    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request, None, Message),
-    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request, None, Message),
+    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request, _S_U8_IN_6.unpack, ReadMturnAngleRequest),
+    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request, _S_U8_IN_6.unpack, ResetMturnAngleRequest),
     b'\x12L\x12\x00': (5, _whole_begin_async_request, None, Message),
     b'\x12L\x13\x01': (6, _whole_end_async_request, None, Message),
-    b'\x12L\x16\x01': (6, _whole_monitor_request, None, Message),
+    b'\x12L\x16\x01': (6, _whole_monitor_request, _S_U8_IN_6.unpack, MonitorRequest),
     b'\x12L\x18\x04': (9, _whole_stop_on_control_mode_request, None, Message),
 }
 
@@ -2002,7 +2006,7 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 # The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
 # for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
 _RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes], tuple[int, ...]] | None, type[Message]]] = {
-    b'\x05\x1c\x01\x01': (6, _whole_ping_response, None, Message),
+    b'\x05\x1c\x01\x01': (6, _whole_ping_response, _S_U8_IN_6.unpack, PingResponse),
     b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response, None, Message),
     b'\x05\x1c\x04\x03': (8, _whole_write_data_response, None, Message),
     b'\x05\x1c\x05!': (38, _whole_read_batch_data_response, None, Message),
@@ -2010,7 +2014,7 @@ _RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Calla
     b'\x05\x1c\x07\x02': (7, _whole_spin_response, None, Message),
     b'\x05\x1c\x08\x02': (7, _whole_rotate_response, None, Message),
     b'\x05\x1c\t\x02': (7, _whole_damping_response, None, Message),
-    b'\x05\x1c\n\x03': (8, _whole_read_angle_response, None, Message),
+    b'\x05\x1c\n\x03': (8, _whole_read_angle_response, _S_U8_I16_IN_8.unpack, ReadAngleResponse),
     b'\x05\x1c\x0b\x02': (7, _whole_move_by_interval_response, None, Message),
     b'\x05\x1c\x0c\x02': (7, _whole_move_by_velocity_response, None, Message),
     b'\x05\x1c\r\x02': (7, _whole_move_mturn_response, None, Message),
@@ -2105,6 +2109,23 @@ REQUEST_FORMAT = FrameFormat(
         0x1101: _run_reset_mturn_angle_request,
         0x1601: _run_monitor_request,
     },
+    units={
+        0x0101: (_S_XX2_U8_X.unpack_from, PingRequest),
+        0x0201: (_S_XX2_U8_X.unpack_from, ResetUserDataRequest),
+        0x0302: (_S_XX2_U8_U8_X.unpack_from, ReadDataRequest),
+        0x0501: (_S_XX2_U8_X.unpack_from, ReadBatchDataRequest),
+        0x0807: (_S_XX2_U8_I16_U16_U16_X.unpack_from, RotateRequest),
+        0x0903: (_S_XX2_U8_U16_X.unpack_from, DampingRequest),
+        0x0a01: (_S_XX2_U8_X.unpack_from, ReadAngleRequest),
+        0x0b0b: (_S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveByIntervalRequest),
+        0x0c0b: (_S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveByVelocityRequest),
+        0x0d0b: (_S_XX2_U8_I32_U32_U16_X.unpack_from, MoveMturnRequest),
+        0x0e0f: (_S_U8_I32_U32_U16_U16_U16_AFTER_HEADER.unpack_from, MoveMturnByIntervalRequest),
+        0x0f0d: (_S_U8_I32_U16_U16_U16_U16_AFTER_HEADER.unpack_from, MoveMturnByVelocityRequest),
+        0x1001: (_S_XX2_U8_X.unpack_from, ReadMturnAngleRequest),
+        0x1101: (_S_XX2_U8_X.unpack_from, ResetMturnAngleRequest),
+        0x1601: (_S_XX2_U8_X.unpack_from, MonitorRequest),
+    },
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -2120,6 +2141,11 @@ RESPONSE_FORMAT = FrameFormat(
         0x0101: _run_ping_response,
         0x0a03: _run_read_angle_response,
         0x1007: _run_read_mturn_angle_response,
+    },
+    units={
+        0x0101: (_S_XX2_U8_X.unpack_from, PingResponse),
+        0x0a03: (_S_XX2_U8_I16_X.unpack_from, ReadAngleResponse),
+        0x1007: (_S_XX2_U8_I32_I16_X.unpack_from, ReadMturnAngleResponse),
     },
 )
 

@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable
 from itertools import accumulate, compress, islice
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.runtime.message import TYPE_CHECKING, Message
+from serialspec.runtime.message import TYPE_CHECKING, Message, build
 
 # frame-level values with a declared range: (offset, size, byte order, signed, low, high, also allowed or None)
 if TYPE_CHECKING:
@@ -45,6 +45,7 @@ class FrameFormat:
         "value_ranges",
         "summed",
         "runs",
+        "units",
     )
 
     header: bytes
@@ -66,6 +67,9 @@ class FrameFormat:
     # laid end to end without their headers, each checked already (their message is their content as unpacked).
     summed: tuple[int, bool] | None
     runs: dict[int, Callable[[bytes], Iterable[Message]]]
+    # The same frames one at a time, by size key: (unpack_from of the bytes after the header giving the values of its
+    # message, its class); the parser checks the sum and builds the message itself, with no call per frame.
+    units: dict[int, tuple[Callable[[bytes], tuple[object, ...]], type[Message]]]
 
     def __init__(
         self,
@@ -80,9 +84,11 @@ class FrameFormat:
         value_ranges: ValueRanges = (),
         summed: tuple[int, bool] | None = None,
         runs: dict[int, Callable[[bytes], Iterable[Message]]] | None = None,
+        units: dict[int, tuple[Callable[[bytes], tuple[object, ...]], type[Message]]] | None = None,
     ) -> None:
         values: tuple[object, ...] = (header, overhead, length_offset, length_adds, command_offset, content_sizes)
         values += (decode_at, {} if fixed is None else fixed, value_ranges, summed, {} if runs is None else runs)
+        values += ({} if units is None else units,)
         for name, value in zip(self.__slots__, values, strict=True):
             object.__setattr__(self, name, value)
 
@@ -94,6 +100,11 @@ class FrameFormat:
         return f"FrameFormat({values})"
 
 
+# A frame whose sum _lean checks and whose message it builds itself: the unpack of its values after the header, its
+# class, the slice of the bytes after the header that its sum adds up, and where its check byte is there.
+_Unit = tuple[Callable[[bytes], tuple[object, ...]], type[Message], slice, int]
+# a key's frames as _lean reads them (see _Candidate.lean)
+_LeanEntry = tuple[int, int, Callable[[bytes, int], "Message | None"] | None, _Unit | None]
 # what _sieve checks a key's frames with (see _Candidate.sieves)
 _Sieve = tuple[bytes, int, int, Callable[[bytes], Iterable[Message]], tuple[tuple[int, bytes], ...]]
 
@@ -202,7 +213,8 @@ class _Candidate:
             key_at[frame_format.command_offset] = 8
         leading = sorted(key_at) == list(range(width, width + len(key_at)))
         self.leading = len(key_at) if leading and self.splittable and not self.shifts and not self.ranges else 0
-        self.lean: dict[bytes, tuple[int, int, Callable[[bytes, int], Message | None] | None]] = {}
+        # (size, bytes after the header, decoder or None, _Unit or None)
+        self.lean: dict[bytes, _LeanEntry] = {}
         # The sieve (see _sieve), for the keys whose frames are checked in runs: their bytes -> (those bytes, frame
         # size, bytes after the header, run decoder, and for each key byte its offset in the piece and a translate
         # table taking its value to 1 and any other to 0).
@@ -210,7 +222,10 @@ class _Candidate:
         if self.leading:
             for key, size in self.frame_sizes.items():
                 first = bytes(key >> key_at[offset] & 0xFF for offset in sorted(key_at))
-                self.lean[first] = (size, size - width, self.fixed.get(key))
+                unit = frame_format.units.get(key) if self.runs else None
+                rest = size - width
+                sums = slice(max(0, frame_format.summed[0] - width) if frame_format.summed else 0, rest - 1)
+                self.lean[first] = (size, rest, self.fixed.get(key), None if unit is None else (*unit, sums, rest - 1))
                 run = self.runs.get(key)
                 if run is not None and self.leading < size - width <= 257:  # no 16-bit lane of _sieve's sums overflows
                     tables = tuple((at, bytes(value == byte for value in range(256))) for at, byte in enumerate(first))
@@ -598,6 +613,7 @@ class StreamParser:
                 if sieved is None:  # a read it is not for: the loop below for a while
                     self._sieve_wait = _SIEVE_AGAIN
         lean, leading = current.lean, current.leading
+        sum_table = current.sum_table
         decode_at = current.decode
         smallest, end = self._smallest, len(buffer)
         found: list[Message] = []
@@ -609,7 +625,17 @@ class StreamParser:
                 entry = lean.get(piece[:leading])
                 after = len(piece)  # bytes before the next header (or the end)
                 if entry is not None:
-                    size, rest, decode = entry
+                    size, rest, decode, unit = entry
+                    if unit is not None and rest <= after:  # the usual frame: its sum checked, its message built
+                        unpack, cls, summed, check = unit
+                        if sum_table[sum(piece[summed]) & 0xFF] == piece[check]:
+                            append(build(cls, unpack(piece)))
+                            taken += size
+                            start = position + size
+                        else:  # corrupt: look again at the next header
+                            errors += 1
+                        position += width + after
+                        continue
                     # the whole frame, and no header inside it; or a header inside it, too late for a frame from
                     # there to complete first (a cut frame start: the frame that follows it is no inner frame)
                     if rest <= after or (after + smallest >= rest and position + size <= end):

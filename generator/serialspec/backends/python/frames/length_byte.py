@@ -58,6 +58,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         dispatch, sizes = table.dispatch, table.sizes
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
         runs = [(key, function["run"]["name"]) for key, _, function in fixed if function.get("run")]
+        units = [(key, f["run"]["unpack"], f["run"]["returns"]) for key, _, f in fixed if f.get("run")]
         sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
         whole = length_byte_whole_frames(layout, [*fixed, *sub_entries])
         rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
@@ -113,6 +114,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
                 # before the frames of one size: where a length byte names both, those keep their decoder
                 "stream_rests": [rest_key(layout, r, False) for r in stream_rests],
                 "runs": runs,
+                "units": units,
                 "summed": stream_sum(protocol, layout) if runs else None,
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],

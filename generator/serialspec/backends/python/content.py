@@ -130,6 +130,12 @@ class Attribute:
     doc: str
     default: str = ""
 
+    @property
+    def stored(self) -> str:
+        """The value the constructor stores: a sequence field's items as a tuple (a list given stays no list, so the
+        message equals the one `decode` gives for its frame); tuple() of a tuple is the tuple itself, ~40 ns."""
+        return f"tuple({self.name})" if self.annotation.startswith("tuple[") else self.name
+
 
 @dataclass
 class ClassCode:

@@ -95,16 +95,13 @@ ELEMENTS = """framing:
 DEFAULT_POSITION = "      default: true\n      fields:\n        position:"
 
 
-def test_the_one_layout_spec_decodes_a_reply_alone(tmp_path: Path) -> None:
-    module = generate_and_import(one_layout_spec(tmp_path), tmp_path / "out", "maestro_elements")
-    assert module.decode(bytes.fromhex("70 17"), module.Direction.RESPONSE) == module.GetPositionResponse(position=6000)
-
-
 def test_the_stream_parser_takes_an_awaited_codeless_reply(tmp_path: Path) -> None:
-    """A bug fixed: one layout's code-less replies of different sizes, which nothing in the frame
-    sizes, are read as the reply awaited (Framing.codeless_replies), byte by byte too; unawaited, their bytes are
-    garbage. The C target refuses such a spec in one line (its decoder reads each frame alone)."""
-    module = generate_and_import(one_layout_spec(tmp_path), tmp_path / "out", "maestro_elements")
+    """A bug fixed: one layout's code-less replies of different sizes, which nothing in the frame sizes, are read
+    as the reply awaited (Framing.codeless_replies), byte by byte too; unawaited, their bytes are garbage; `decode`
+    alone gives the default reply. The C target refuses such a spec in one line (its decoder reads each frame
+    alone). One generation for all of it: the test that decoded a reply alone is folded in here."""
+    path = one_layout_spec(tmp_path)
+    module = generate_and_import(path, tmp_path / "out", "maestro_elements")
     parser = module.StreamParser(module.Direction.RESPONSE)
     parser.expect(module.GetPositionResponse, module.GetPositionRequest(channel=2))
     assert parser.feed(bytes.fromhex("70 17")) == [module.GetPositionResponse(position=6000)]
@@ -113,7 +110,7 @@ def test_the_stream_parser_takes_an_awaited_codeless_reply(tmp_path: Path) -> No
     parser.expect(None)
     assert parser.feed(bytes.fromhex("70 17")) == []
     assert module.decode(bytes.fromhex("70 17"), module.Direction.RESPONSE) == module.GetPositionResponse(6000)
-    protocol = load_protocol(one_layout_spec(tmp_path))
+    protocol = load_protocol(path)
     assert protocol.framing.by_request(Direction.RESPONSE)
     assert not load_protocol(SPEC).framing.codeless_replies  # layouts chosen by command: by_command says it
     with pytest.raises(Unsupported, match="code-less replies"):

@@ -474,6 +474,8 @@ class FieldResolver(Pass):
                     return  # derived by its own expression, which decoding checks
                 if not isinstance(field, Scalar) or field.type.is_float or field.hidden:
                     raise self.fail(path, f"{name!r} must be an earlier integer field that nothing else derives")
+                if field.seven_bit:
+                    raise self.fail(path, f"{name!r} holds a count or size: plain, not encoding seven_bit")
                 siblings[index] = replace(field, derived=derivation)
                 return
         raise self.fail(path, f"unknown field {name!r}: a count or size must be an earlier field of the same content")

@@ -190,7 +190,9 @@ CASES: dict[str, Case] = {
             }
         },
     ),
-    "encoding: plain": same({"v": {"type": "i16", "encoding": "plain"}}),
+    "encoding: plain, seven_bit": same(
+        {"v": {"type": "i16", "encoding": "plain"}, "t": {"type": "u16", "encoding": "seven_bit"}, "w": "u8"}
+    ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
     "endian: big": same({"v": {"type": "u32", "endian": "big"}, "w": {"type": "f32", "endian": "big"}}),
     "endian: little": same({"v": {"type": "u32", "endian": "little"}}),

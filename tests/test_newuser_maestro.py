@@ -2,10 +2,11 @@
 No PyPI package speaks the Maestro's serial protocol (`maestro-servo` 0.2.0 and `pymaestro` drive its USB control
 transfers, `maestro` is unrelated, `pololu-maestro` does not exist), so the peer is the user's guide (section 5.e,
 Serial Servo Commands): its printed bytes are our golden frames, and a raw pyserial session sending the guide's
-bytes drives `serialspec sim`, as does our client. Two language gaps are strict xfails: a 14-bit value sent as two
-7-bit bytes, and the Pololu protocol form of the same commands (0xAA, device number, command with bit 7 cleared);
-so is a bug: replies without a code, of different sizes, in a plain `framing.elements` spec are never taken by the
-stream parser (the spec names one layout from every command instead, which works)."""
+bytes drives `serialspec sim`, as does our client. A 14-bit value sent as two 7-bit bytes is one field
+(`encoding: seven_bit`). The Pololu protocol form of the same commands (0xAA, device number, command with bit 7
+cleared) is a strict xfail, a language gap. Replies without a code, of different sizes, in a plain
+`framing.elements` spec are taken by the stream parser as the reply awaited (a bug once; the spec names one layout
+from every command, which works too)."""
 
 from __future__ import annotations
 
@@ -15,16 +16,20 @@ from types import ModuleType
 
 import pytest
 from conftest import generate_and_import
+from serialspec.backends import Unsupported
+from serialspec.backends.c.build import files as c_files
 from serialspec.lang import load_protocol
+from serialspec.runtime.errors import DecodeError, RangeError
+from serialspec.runtime.message import Direction
 from sim_process import serve
 
 SPEC = Path(__file__).parent / "specs" / "maestro.yaml"
 
 # (guide's bytes, message class, fields) for the compact protocol: section 5.e's commands.
 GUIDE_REQUESTS = [
-    ("84 02 70 2e", "SetTargetRequest", {"channel": 2, "target_low": 0x70, "target_high": 0x2E}),  # its example
-    ("87 05 0c 01", "SetSpeedRequest", {"channel": 5, "speed_low": 0x0C, "speed_high": 0x01}),  # 140 × 0.25 µs/10 ms
-    ("89 00 04 00", "SetAccelerationRequest", {"channel": 0, "acceleration_low": 4, "acceleration_high": 0}),
+    ("84 02 70 2e", "SetTargetRequest", {"channel": 2, "target": 6000}),  # its example
+    ("87 05 0c 01", "SetSpeedRequest", {"channel": 5, "speed": 140}),  # 140 × 0.25 µs/10 ms
+    ("89 00 04 00", "SetAccelerationRequest", {"channel": 0, "acceleration": 4}),
     ("90 05", "GetPositionRequest", {"channel": 5}),
     ("93", "GetMovingStateRequest", {}),
     ("a1", "GetErrorsRequest", {}),
@@ -48,12 +53,12 @@ def test_the_guides_requests(ma: ModuleType, printed: str, name: str, fields: di
 def test_the_target_example_is_1500_us(ma: ModuleType) -> None:
     """The guide: 1500 µs is 6000 quarter-microseconds, 01011101110000 in binary, sent low 7 bits first."""
     message = ma.decode(bytes.fromhex("84 02 70 2e"), ma.Direction.REQUEST)
-    assert message.target_low | message.target_high << 7 == 6000
+    assert message.target == 6000
 
 
-def test_a_data_byte_with_bit_7_set_is_refused_before_encoding(ma: ModuleType) -> None:
-    with pytest.raises(ValueError, match="target_low"):
-        ma.encode(ma.SetTargetRequest(channel=2, target_low=0xF0, target_high=0x2E))
+def test_a_target_past_14_bits_is_refused_before_encoding(ma: ModuleType) -> None:
+    with pytest.raises(ValueError, match=r"target = 16384 is outside its range 0\.\.16383"):
+        ma.encode(ma.SetTargetRequest(channel=2, target=16384))
 
 
 def test_the_guides_bytes_drive_the_sim() -> None:
@@ -68,16 +73,6 @@ def test_the_guides_bytes_drive_the_sim() -> None:
         assert port.read(2) == b"\x00\x00"
         port.write(bytes.fromhex("93"))
         assert port.read(1) == b"\x00"
-
-
-CODELESS_REPLIES = (
-    "bug: replies that carry no code, one of them `default: true` and the others chosen by the request they answer "
-    "(the `default` key's own description), are decoded by `decode` but never taken by the stream parser, even while "
-    "it awaits one (`expect(GetPositionResponse, request)`): `feed(70 17)` gives [] where a spec with one such reply "
-    "gives GetPositionResponse(position=6000), so the client times out on every get_* although the simulator answers "
-    "(the response codec's content sizes are {None: (1, 2)}, and runtime/framing.py's probe asks the awaited class "
-    "only for layouts chosen by command); tests/specs/maestro.yaml works around it with one layout every command names"
-)
 
 
 def one_layout_spec(tmp_path: Path) -> Path:
@@ -100,23 +95,32 @@ ELEMENTS = """framing:
 DEFAULT_POSITION = "      default: true\n      fields:\n        position:"
 
 
-def test_the_one_layout_spec_decodes_a_reply_alone(tmp_path: Path) -> None:
-    module = generate_and_import(one_layout_spec(tmp_path), tmp_path / "out", "maestro_elements")
-    assert module.decode(bytes.fromhex("70 17"), module.Direction.RESPONSE) == module.GetPositionResponse(position=6000)
-
-
-@pytest.mark.xfail(strict=True, reason=CODELESS_REPLIES)
 def test_the_stream_parser_takes_an_awaited_codeless_reply(tmp_path: Path) -> None:
-    module = generate_and_import(one_layout_spec(tmp_path), tmp_path / "out", "maestro_elements")
+    """A bug fixed: one layout's code-less replies of different sizes, which nothing in the frame sizes, are read
+    as the reply awaited (Framing.codeless_replies), byte by byte too; unawaited, their bytes are garbage; `decode`
+    alone gives the default reply. The C target refuses such a spec in one line (its decoder reads each frame
+    alone). One generation for all of it: the test that decoded a reply alone is folded in here."""
+    path = one_layout_spec(tmp_path)
+    module = generate_and_import(path, tmp_path / "out", "maestro_elements")
     parser = module.StreamParser(module.Direction.RESPONSE)
     parser.expect(module.GetPositionResponse, module.GetPositionRequest(channel=2))
     assert parser.feed(bytes.fromhex("70 17")) == [module.GetPositionResponse(position=6000)]
+    parser.expect(module.GetMovingStateResponse, module.GetMovingStateRequest())
+    assert [m for byte in b"\x01" for m in parser.feed(bytes([byte]))] == [module.GetMovingStateResponse(moving=1)]
+    parser.expect(None)
+    assert parser.feed(bytes.fromhex("70 17")) == []
+    assert module.decode(bytes.fromhex("70 17"), module.Direction.RESPONSE) == module.GetPositionResponse(6000)
+    protocol = load_protocol(path)
+    assert protocol.framing.by_request(Direction.RESPONSE)
+    assert not load_protocol(SPEC).framing.codeless_replies  # layouts chosen by command: by_command says it
+    with pytest.raises(Unsupported, match="code-less replies"):
+        c_files(protocol)
 
 
 def test_the_generated_client_asks_the_sim(ma: ModuleType) -> None:
     client_module = importlib.import_module("maestro.client")
     with serve(str(SPEC)) as path, client_module.MaestroClient(path, timeout=5) as maestro:
-        maestro.set_target(2, 0x70, 0x2E)
+        maestro.set_target(2, 6000)
         assert maestro.get_position(2) == 6000
         assert maestro.get_moving_state() == 0
         assert maestro.get_errors() == ma.ErrorsBits(**dict.fromkeys(ma.ErrorsBits.__match_args__, 0))
@@ -141,19 +145,19 @@ commands:
 """
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: a 14-bit integer sent as two bytes of 7 bits, low first (Pololu Maestro targets, speeds, "
-    "accelerations; MIDI pitch bend): the spec needs to say `target: {type: u16, encoding: seven_bit}` (one field "
-    "holding 6000 for 70 2E); the loader says `encoding` is one of plain, sign_magnitude, and the spec must split the "
-    "value into target_low and target_high fields the user joins by hand",
-)
 def test_a_14_bit_value_in_two_7_bit_bytes(tmp_path: Path) -> None:
+    """`encoding: seven_bit` (a language gap once): one field holding 6000 for 70 2E; a byte with bit 7 set is no
+    such value, and a value past 14 bits is refused before a byte is written."""
     path = tmp_path / "maestro7.yaml"
     path.write_text(SEVEN_BIT, "utf-8")
     module = generate_and_import(path, tmp_path / "out", "maestro7")
     message = module.SetTargetRequest(channel=2, target=6000)
     assert module.encode(message) == bytes.fromhex("84 02 70 2e")
+    assert module.decode(bytes.fromhex("84 02 70 2e"), module.Direction.REQUEST) == message
+    with pytest.raises(DecodeError, match="bit 7 of a byte of target"):
+        module.decode(bytes.fromhex("84 02 f0 2e"), module.Direction.REQUEST)
+    with pytest.raises(RangeError, match=r"target = 16384 is outside its range 0\.\.16383"):
+        module.encode(module.SetTargetRequest(channel=2, target=16384))
 
 
 POLOLU_FORM = """

@@ -25,7 +25,7 @@ def build(out: Path) -> Path:
         shutil.copy(HERE / "pyproject.toml", project)
         source = ROOT / "generator" / "serialspec"
         target = stage / "generator" / "serialspec"
-        for package in ("runtime", "checksums", "transforms"):  # each algorithm's, each transform's runtime code
+        for package in ("runtime", "checksums", "transforms", "encodings"):  # each one's runtime code
             shutil.copytree(source / package, target / package, ignore=shutil.ignore_patterns("__pycache__"))
         for name in ("__init__.py", "py.typed"):
             shutil.copy(source / name, target / name)

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "d034fa076186a36c52fc3db7d619bee828604ced6a9454b544eda8efd4dcc383"
+#define CRSF_SPEC_SHA256 "4e23c8d95df402e5b6791811e040a2f138f7f96847c90a3246e5a22d496e0954"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

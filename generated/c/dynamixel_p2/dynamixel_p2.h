@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "34a89aa29daa8f6bb2b26c26b1bec2c41640d3113b9b67cfdb8fd013cf82c75b"
+#define DYNAMIXEL_P2_SPEC_SHA256 "9c9515b0047b55f3a9373e21e21a36f95e268986cea84295af0a13d4623658f1"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "99319681cf50fb9f7844a361fd13d1c5d6d910a64088e918635fd98bb7d6855f"
+#define HIWONDER_RRC_SPEC_SHA256 "499296f4a990bfb97dd94d3871d8af47f1204d7bf93c0e8c0b45062ce6dba6fe"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

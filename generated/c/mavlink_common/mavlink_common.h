@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "6913e85dabf7f893819cb2c8558a795454a54f967e82e913e0638b81518bb3d8"
+#define MAVLINK_COMMON_SPEC_SHA256 "83705f750c0fdf5a5dd6b74343ffc67a73953133d627ec18cc79ea4aede70456"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

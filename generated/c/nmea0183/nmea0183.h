@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "9fea1eaabcdeba98bf38a819a82d78e2eaf8f25f405f98f856c99e5b4bdc2e3d"
+#define NMEA0183_SPEC_SHA256 "5dfa08c8d9422a87529a79454aa08bf394ed799cce87bbf493a86e4d9dbcc1ce"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "b3f875468d959d3693786ed68866f80b2f749eedcfd38c18952145fb9f789685"
+#define UBX_SPEC_SHA256 "d9182d951a01f9bbfa80af95345bb13521253dc66d93c23603d015083fbb5535"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

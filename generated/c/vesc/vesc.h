@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "377dd4927d8fc53512a2eef1d397b0a3f096ceeadd7f6ffe297573bf6d308f6d"
+#define VESC_SPEC_SHA256 "f67efcf7f8f7918db222c3c4ae1af9eb92270cb387faebf80073dbb7ad9542b7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

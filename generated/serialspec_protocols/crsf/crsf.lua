@@ -1376,6 +1376,10 @@ local function add_scalar(f, tree, range, scope)
     local top = 2 ^ (SIZES[f.type] * 8 - 1)
     if value >= top then value = -(value - top) end
     item = tree:add(f.pf, range, value)
+  elseif f.seven_bit then
+    value = seven_bit(value, SIZES[f.type])
+    if value == nil then error(string.format("%s: bit 7 of a byte is set", f.name), 0) end
+    item = tree:add(f.pf, range, value)
   else
     item = add(tree, f.pf, range, f.big)
   end

@@ -732,7 +732,7 @@ class SyncReadRequest(Message):
         length: int,
         ids: tuple[IdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, ids))
+        return _build(cls, (id, address, length, tuple(ids)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -778,7 +778,7 @@ class FastSyncReadRequest(Message):
         length: int,
         servo_ids: tuple[ServoIdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, servo_ids))
+        return _build(cls, (id, address, length, tuple(servo_ids)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -821,7 +821,7 @@ class SyncWriteRequest(Message):
         address: int,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, servos))
+        return _build(cls, (id, address, tuple(servos)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -859,7 +859,7 @@ class BulkReadRequest(Message):
         id: int,
         reads: tuple[ReadsItem, ...],
     ) -> Self:
-        return _build(cls, (id, reads))
+        return _build(cls, (id, tuple(reads)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -895,7 +895,7 @@ class BulkWriteRequest(Message):
         id: int,
         writes: tuple[WritesItem, ...],
     ) -> Self:
-        return _build(cls, (id, writes))
+        return _build(cls, (id, tuple(writes)))
 
     def to_fields(self) -> dict[str, Any]:
         return {

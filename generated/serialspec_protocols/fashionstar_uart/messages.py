@@ -1939,7 +1939,7 @@ class SyncCommandRequest(Message):
         command: int,
         blocks: tuple[BlocksItem, ...],
     ) -> Self:
-        return _build(cls, (command, blocks))
+        return _build(cls, (command, tuple(blocks)))
 
     def to_fields(self) -> dict[str, Any]:
         return {

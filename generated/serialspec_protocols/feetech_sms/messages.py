@@ -422,7 +422,7 @@ class SyncReadRequest(Message):
         length: int,
         ids: tuple[IdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, ids))
+        return _build(cls, (id, address, length, tuple(ids)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -465,7 +465,7 @@ class SyncWriteRequest(Message):
         address: int,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, servos))
+        return _build(cls, (id, address, tuple(servos)))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -514,7 +514,7 @@ class MotorSetSpeedsRequest(Message):
         cls,
         motors: tuple[MotorsItem, ...],
     ) -> Self:
-        return _build(cls, (motors,))
+        return _build(cls, (tuple(motors),))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -581,7 +581,7 @@ class MotorSetDutiesRequest(Message):
         cls,
         duties: tuple[DutiesItem, ...],
     ) -> Self:
-        return _build(cls, (duties,))
+        return _build(cls, (tuple(duties),))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -651,7 +651,7 @@ class PwmServoSetPositionsRequest(Message):
         duration: int,
         pwm_servos: tuple[PwmServosItem, ...],
     ) -> Self:
-        return _build(cls, (duration, pwm_servos))
+        return _build(cls, (duration, tuple(pwm_servos)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -913,7 +913,7 @@ class BusServoSetPositionsRequest(Message):
         duration: int,
         bus_servos: tuple[BusServosItem, ...],
     ) -> Self:
-        return _build(cls, (duration, bus_servos))
+        return _build(cls, (duration, tuple(bus_servos)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1177,7 +1177,7 @@ class BusServoStopRequest(Message):
         cls,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (servos,))
+        return _build(cls, (tuple(servos),))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2136,7 +2136,7 @@ class SbusResponse(Message):
         signal_loss: int,
         fail_safe: int,
     ) -> Self:
-        return _build(cls, (channels, ch17, ch18, signal_loss, fail_safe))
+        return _build(cls, (tuple(channels), ch17, ch18, signal_loss, fail_safe))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2246,7 +2246,7 @@ class RgbSetPixelsRequest(Message):
         cls,
         pixels: tuple[PixelsItem, ...],
     ) -> Self:
-        return _build(cls, (pixels,))
+        return _build(cls, (tuple(pixels),))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -141,7 +141,7 @@ class ReadCoilsResponse(Message):
         unit: int,
         coils: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, coils))
+        return _build(cls, (unit, tuple(coils)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -220,7 +220,7 @@ class ReadDiscreteInputsResponse(Message):
         unit: int,
         inputs: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, inputs))
+        return _build(cls, (unit, tuple(inputs)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -299,7 +299,7 @@ class ReadHoldingRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, registers))
+        return _build(cls, (unit, tuple(registers)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -378,7 +378,7 @@ class ReadInputRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, registers))
+        return _build(cls, (unit, tuple(registers)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -583,7 +583,7 @@ class WriteCoilsRequest(Message):
         address: int,
         values: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, address, values))
+        return _build(cls, (unit, address, tuple(values)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -668,7 +668,7 @@ class WriteRegistersRequest(Message):
         address: int,
         values: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, address, values))
+        return _build(cls, (unit, address, tuple(values)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -851,7 +851,7 @@ class ReadWriteRegistersRequest(Message):
         write_address: int,
         values: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, read_address, read_count, write_address, values))
+        return _build(cls, (unit, read_address, read_count, write_address, tuple(values)))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -896,7 +896,7 @@ class ReadWriteRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, registers))
+        return _build(cls, (unit, tuple(registers)))
 
     def to_fields(self) -> dict[str, Any]:
         return {

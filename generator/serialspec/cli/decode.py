@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         return replay(args, protocol, package)
 
     def decode(frame: bytes) -> Message:
-        if request is not None and (protocol.framing.by_command or protocol.framing.from_request):
+        if request is not None and protocol.framing.requesting:
             return package.decode(frame, args.direction, expect, request)  # type: ignore[no-any-return]
         return package.decode(frame, args.direction, expect)  # type: ignore[no-any-return]
 

@@ -14,6 +14,7 @@ from typing import Any, assert_never
 
 from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
+from serialspec.encodings import seven_bit
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
@@ -385,8 +386,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str(
-        "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
-        choices=("plain", "sign_magnitude"),
+        "How the integer is stored: plain two's complement, sign_magnitude (top bit the sign, the rest the size), or "
+        f"{seven_bit.DOC}.",
+        choices=("plain", "sign_magnitude", seven_bit.NAME),
         default="plain",
         example="sign_magnitude",
     ),
@@ -559,7 +561,9 @@ MESSAGE = Obj(
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
-            "request it answers is unknown; the others are chosen by the request they answer.",
+            "request it answers is unknown; the others are chosen by the request they answer. Code-less replies of "
+            "different sizes in one layout with no length element, terminator or transform are sized by the reply "
+            "awaited: a stream parser takes them only while it awaits one (`expect`, as the client does).",
             default=False,
             example=True,
         ),

@@ -675,11 +675,13 @@ class FrameCodec:
         """Check a frame and take it apart: in the layout its header names, in the layout of its code (layouts
         chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class)."""
         if self.replies:
-            if expect is None:
+            if expect is None and len(self.layouts) > 1:
                 raise DecodeError(
                     "a reply without a command code is read in the layout of the request it answers: give the request"
                 )
             index = self.replies.get(_class_name(expect))
+            if index is None and expect is None and len(self.layouts) == 1:
+                return self.layouts[0].unwrap(frame, request)  # one layout: the frame alone, its default reply
             if index is None:
                 raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
             return self.layouts[index].unwrap(frame, request)

@@ -21,6 +21,7 @@ from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.frames import refuse_by_command
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
+from serialspec.encodings import seven_bit
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -268,8 +269,10 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
-                if f.sign_magnitude and wide(f.type):
-                    raise Unsupported(f"{where}: {f.name}: sign-magnitude {f.type.name}")
+                if (f.sign_magnitude or f.seven_bit) and wide(f.type):
+                    raise Unsupported(
+                        f"{where}: {f.name}: {'sign-magnitude' if f.sign_magnitude else 'seven_bit'} {f.type.name}"
+                    )
             case Array() | Packed():
                 pass
             case List():
@@ -533,7 +536,13 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 # a hidden value keeps its wire bits, a signed one its value (as Python compares it); a constant
                 # only its bits: no helper is written that nothing calls
                 needs_value = f.const is None and (not f.hidden or f.type.signed) and not f.sign_magnitude
+                needs_value = needs_value and not f.seven_bit
                 value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value else ""
+                if f.seven_bit:  # 7 bits a byte, bit 7 of each clear
+                    raw = get_raw(ctx, f.type, f.endian, "c + o")
+                    marks = seven_bit.marks(size)
+                    out.append(f"{pad}if (({raw} & 0x{marks:x}UL) != 0u) {{ return {ctx.P}_E_CONTENT; }}")
+                    value = f"({ctype(f.type)}){seven_bit.c_decode(raw, size)}"
                 if f.sign_magnitude:  # the top bit is the sign, the rest the magnitude
                     top = 1 << (8 * size - 1)
                     raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
@@ -1124,6 +1133,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     if f.sign_magnitude:
                         top = 1 << (8 * size - 1)
                         value = f"({tgt} < 0 ? ((uint32_t)(-(int32_t){tgt}) | 0x{top:x}UL) : (uint32_t){tgt})"
+                    if f.seven_bit:
+                        value = seven_bit.c_encode(tgt, size)
                 out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
                 out.append(f"{pad}{put_call(ctx, f.type, f.endian, 'c + o', value)} /* {f.name} */")
                 out.append(f"{pad}o += {size}u;")

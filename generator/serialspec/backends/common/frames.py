@@ -96,6 +96,8 @@ def refuse_by_command(protocol: Protocol) -> None:
         raise Unsupported("layouts chosen by command (`layout:`)")
     if protocol.framing.from_request:
         raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
+    if protocol.framing.by_request(Direction.RESPONSE):
+        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
 
 
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:

@@ -326,7 +326,7 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
     layout = protocol.layout(message)  # its own, where layouts are chosen by command
     code = protocol.command(message.command).wire_code(Direction.RESPONSE) if layout.has_command else None
     sharing, asking = reply_sharing(protocol)
-    if protocol.framing.by_request(Direction.RESPONSE):
+    if protocol.framing.by_command and protocol.framing.by_request(Direction.RESPONSE):
         return "read in the layout of the request it answers (decoding it needs that request)"
     if sharing[code] < 2:
         return ""
@@ -337,7 +337,9 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
         if message.default_reply
         else "; chosen by the request it answers (the replies share their code)"
     )
-    return f"the layout of the replies to {answers}{default}"
+    # one layout that cannot size a code-less reply: the reply awaited does
+    sized = "; a stream parser takes it only while awaiting it" if protocol.framing.codeless_replies else ""
+    return f"the layout of the replies to {answers}{default}{sized}"
 
 
 _SHARING: dict[int, tuple[Protocol, Counter[int | None], dict[str, set[str]]]] = {}

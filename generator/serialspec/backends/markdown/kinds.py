@@ -9,6 +9,7 @@ from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
+from serialspec.encodings import seven_bit
 from serialspec.lang import expression
 from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
 
@@ -51,6 +52,7 @@ class ScalarKind(Kind[Scalar]):
 
     def type_name(self, f: Scalar) -> str:
         name = f.type.name + (" (sign-magnitude)" if f.sign_magnitude else "")
+        name += seven_bit.TYPE_NOTE if f.seven_bit else ""
         if f.enum:
             name += f" enum [{f.enum.class_name}](#enum-{anchor(f.enum.name)})"
         if f.flags:

@@ -156,6 +156,8 @@ class ScalarKind(Kind[Scalar]):
             return bits_expr(f)
         if f.sign_magnitude:
             return f"SignMagnitude({base}, {f.type.size * 8})"
+        if f.seven_bit:
+            return f"SevenBit({base}, {f.type.size})"
         return base
 
     def fixed(self, f: Scalar) -> bool:

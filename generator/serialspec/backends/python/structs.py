@@ -95,7 +95,7 @@ def structs_module(protocol: Protocol) -> str:
             definitions += ["", *lines]
             names |= used
         # replies read with their request (layouts chosen by command, a checksum over request bytes): its frames'
-        requests = protocol.framing.by_command or protocol.framing.from_request
+        requests = protocol.framing.requesting
         asked = {d: ", _REQUEST_FRAMES" if requests and d == Direction.RESPONSE else "" for d in Direction}
         frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES{asked[d]})"} for d in Direction]
     return render(

@@ -66,7 +66,7 @@ class _Checker:
     def asked(self, example: Example) -> Any:
         """The request a reply example answers (its `request` example, decoded), where replies are read with it."""
         framing = self.protocol.framing
-        if not example.request or not (framing.by_command or framing.from_request):
+        if not example.request or not framing.requesting:
             return None
         found = next((e for e in self.protocol.examples if e.name == example.request), None)
         try:

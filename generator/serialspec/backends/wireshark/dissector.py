@@ -14,6 +14,7 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
+from serialspec.encodings import seven_bit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -73,6 +74,10 @@ def emit_dissector(protocol: Protocol) -> str:
         layouts=lua(shared, 0),
         data=lua(data, 0),
         checksums=_checksum_functions(protocol),
+        # the `encoding: seven_bit` function, where a field uses it
+        seven_bit_lua=seven_bit.LUA
+        if any(isinstance(f, Scalar) and f.seven_bit for m in protocol.messages() for f in _all_fields(m.fields))
+        else "",
     )
 
 
@@ -256,6 +261,8 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
             common["offset"] = item.offset
             common.update(_scalar_extras(item.flags, item.bits, item.enum), hidden=item.hidden)
             common["sign_magnitude"] = item.sign_magnitude
+            if item.seven_bit:  # (absent: nil, false to the engine)
+                common["seven_bit"] = True
         case Array():
             common.update(kind="list", type=item.item.name, big=item.endian == ">", count=item.count, unit=item.unit)
         case List():

@@ -125,6 +125,7 @@ class Scalar(Common):
     value: Expr | None = None
     offset: float | None = None  # engineering value = wire value × scale + offset
     value_at: tuple[int, int] = (1, 1)  # line and column of `value:` in the spec, for a target's refusal of it
+    seven_bit: bool = False  # `encoding: seven_bit`: 7 bits a byte (serialspec/encodings/seven_bit.py)
 
     @property
     def odd_width(self) -> bool:

@@ -137,6 +137,9 @@ class Framing:
     gap: float = 0.0  # silence between frames, in character times (0: none defined)
     reply_code: str = ""  # the command element's `reply_code`, as shown (`code | 0x40`): see Command.response_code
     by_command: bool = False  # a command names its layout (`layout:`): layouts are chosen by command, not by header
+    # one layout's replies carry no code, differ in size, and nothing in the frame sizes them (no length element, no
+    # terminator, no transform): each is read as the reply awaited, as replies in layouts chosen by command are
+    codeless_replies: bool = False
 
     def layout_of(self, direction: Direction, name: str) -> FrameLayout:
         """The layout of a direction by its name ("": the first), where layouts are chosen by command."""
@@ -148,9 +151,19 @@ class Framing:
         return any(c.from_request for layout in self.alternatives.get(Direction.RESPONSE, ()) for c in layout.checksums)
 
     def by_request(self, direction: Direction) -> bool:
-        """Frames of this direction are read in the layout of the request they answer (they carry no code)."""
+        """Frames of this direction are read in the layout of the request they answer (they carry no code): layouts
+        chosen by command, or one layout's code-less replies that only the awaited reply sizes (`codeless_replies`)."""
         layouts = self.alternatives.get(direction, ())
-        return self.by_command and direction == Direction.RESPONSE and not any(lay.has_command for lay in layouts)
+        return (
+            (self.by_command or self.codeless_replies)
+            and direction == Direction.RESPONSE
+            and not any(lay.has_command for lay in layouts)
+        )
+
+    @property
+    def requesting(self) -> bool:
+        """Decoding a reply can take the request it answers: its layout (`by_request`) or its checksum need it."""
+        return self.by_command or self.from_request or self.by_request(Direction.RESPONSE)
 
     @property
     def classic(self) -> bool:

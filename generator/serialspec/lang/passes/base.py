@@ -13,6 +13,7 @@ import sys
 from dataclasses import field
 from typing import Any, Literal
 
+from serialspec.encodings import seven_bit
 from serialspec.lang import grammar
 from serialspec.lang.errors import SpecError
 from serialspec.lang.frozen import mutable
@@ -356,11 +357,19 @@ class Pass:
         return SCALARS[f"u{scalar.size * 8}"]
 
     def bounds(
-        self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path, sign_bit: int | None = None
+        self,
+        scalar: ScalarType,
+        sign_magnitude: bool,
+        given: Any,
+        path: Path,
+        sign_bit: int | None = None,
+        seven_bits: bool = False,
     ) -> tuple[float, float]:
         if sign_magnitude:
             limit = (1 << (sign_bit if sign_bit is not None else scalar.size * 8 - 1)) - 1
             low, high = float(-limit), float(limit)
+        elif seven_bits:
+            low, high = 0.0, float(seven_bit.maximum(scalar.size))
         else:
             low, high = scalar.minimum, scalar.maximum
         if given is None:
@@ -369,5 +378,6 @@ class Pass:
         if given_low > given_high:
             self.error(path, f"range [{given_low}, {given_high}] is empty")
         if given_low < low or given_high > high:
-            self.error(path, f"range [{given_low}, {given_high}] does not fit {scalar.name} ({low:g}..{high:g})")
+            what = f"{scalar.name} {seven_bit.NAME}" if seven_bits else scalar.name
+            self.error(path, f"range [{given_low}, {given_high}] does not fit {what} ({low:g}..{high:g})")
         return given_low, given_high

@@ -53,6 +53,9 @@ class Commands(FieldResolver):
             self.check_layouts(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
             self.check_seeds(self.ctx.framing)
+            self.ctx.framing = replace(
+                self.ctx.framing, codeless_replies=codeless_replies(self.ctx.commands, self.ctx.framing)
+            )
         self.check_answered_by(self.ctx.commands)
         self.check_request_references(self.ctx.commands)
         self.check_matching(self.ctx.commands, self.ctx.framing)
@@ -596,6 +599,22 @@ class Commands(FieldResolver):
         if position == offset:
             return (*fields, const)
         raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")
+
+
+def codeless_replies(commands: list[Command], framing: Framing) -> bool:
+    """One response layout without a command element, length, terminator or transform, whose replies (all awaited,
+    none unsolicited) differ in size: the frame cannot size a reply, the reply awaited does (Framing.by_request).
+    FEETECH's and DYNAMIXEL's status replies carry a length: they are read alone."""
+    layouts = framing.alternatives.get(Direction.RESPONSE, ())
+    if framing.by_command or len(layouts) != 1:
+        return False
+    layout = layouts[0]
+    if layout.has_command or layout.length is not None or layout.trailer or layout.transparency is not None:
+        return False
+    replies = [m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE]
+    if len(replies) < 2 or any(m.unsolicited for m in replies):
+        return False
+    return len({(m.min_size, m.max_size) for m in replies}) > 1 or replies[0].min_size != replies[0].max_size
 
 
 def message_path(message: Message) -> Path:

@@ -6,6 +6,7 @@ import re
 from dataclasses import replace
 from typing import Any, Literal
 
+from serialspec.encodings import seven_bit
 from serialspec.lang import expression, grammar
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -386,7 +387,13 @@ class FieldResolver(Pass):
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         scalar = self.stored(SCALARS[spec["type"]], sign_magnitude, (*path, "encoding"))
-        low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"))
+        seven_bits = spec.get("encoding") == seven_bit.NAME
+        if seven_bits and (why := seven_bit.problem(scalar.name, scalar.signed, scalar.is_float)):
+            self.error((*path, "encoding"), why)
+            seven_bits = False
+        if seven_bits and (mixed := [key for key in ("const", "bits", "flags", "value") if key in spec]):
+            self.error((*path, mixed[0]), f"`{mixed[0]}` does not go with encoding seven_bit (a number 7 bits a byte)")
+        low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"), seven_bits=seven_bits)
         value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
         if value_enum is not None and spec.get("range") is None:
             low, high = enum_span(value_enum, low, high)
@@ -437,6 +444,7 @@ class FieldResolver(Pass):
             value=self.derived_value(spec, scalar, path),
             offset=spec.get("offset"),
             value_at=self.doc.where((*path, "value")),
+            seven_bit=seven_bits,
         )
 
     def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:
@@ -466,6 +474,8 @@ class FieldResolver(Pass):
                     return  # derived by its own expression, which decoding checks
                 if not isinstance(field, Scalar) or field.type.is_float or field.hidden:
                     raise self.fail(path, f"{name!r} must be an earlier integer field that nothing else derives")
+                if field.seven_bit:
+                    raise self.fail(path, f"{name!r} holds a count or size: plain, not encoding seven_bit")
                 siblings[index] = replace(field, derived=derivation)
                 return
         raise self.fail(path, f"unknown field {name!r}: a count or size must be an earlier field of the same content")

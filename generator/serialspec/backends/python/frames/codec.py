@@ -113,7 +113,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     frames/), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
     decoders by code (and by class)."""
     # layouts chosen by command, checksums over request bytes: the engine's code only (no straight-line checks)
-    engine_only = protocol.framing.by_command or protocol.framing.from_request
+    engine_only = protocol.framing.requesting
     imports, definitions = checksum_definitions(protocol, straight=not engine_only)
     directions: list[dict[str, Any]] = []
     dispatchers = []
@@ -130,7 +130,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         dispatch, sizes, single, expected = table.dispatch, table.sizes, table.single, table.expected
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
-        requesting = protocol.framing.by_command or protocol.framing.from_request
+        requesting = protocol.framing.requesting
         optional = tuple(e.name for e in optional_elements(protocol, direction))
         frames = Target(
             direction.name, values, expected=bool(expected), only=only, requesting=requesting, optional=optional
@@ -175,7 +175,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
     by_header = all(headers) and len(set(headers)) == len(headers)
-    requesting = protocol.framing.by_command or protocol.framing.from_request
+    requesting = protocol.framing.requesting
     return {
         "length_byte_frames": False,
         "requesting": requesting,

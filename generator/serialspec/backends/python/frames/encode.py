@@ -462,7 +462,7 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             wrap = f"return _RESPONSE_FRAMES.wrap({content}, {code}, {values}, {index})"
             body.append(Code(wrap, lists=packed_lists(parts)))
             return body
-        if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
+        if framing.requesting:  # its layout, and the request a reply answers
             arguments += f", {layout_index(package.protocol, message)}, request"
         arguments += extras
         body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))

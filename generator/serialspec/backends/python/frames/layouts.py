@@ -218,7 +218,7 @@ def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayo
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
-    if protocol.framing.by_command or protocol.framing.from_request:
+    if protocol.framing.requesting:
         return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(
         {

@@ -1,0 +1,4 @@
+"""Integer encodings beyond plain two's complement (a field's `encoding:`), one module each owning its grammar text,
+validation, runtime and the code of every backend: `seven_bit` (7 bits a byte, Pololu Maestro, MIDI). The package
+imports nothing of the generator; the runtime wheel ships it (generated structs import its construct adapters).
+`sign_magnitude` predates it and is still spread over the passes and backends (a candidate to move here)."""

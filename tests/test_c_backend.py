@@ -158,6 +158,32 @@ def test_compiles_without_a_warning(g: Generated, level: str, build: str, tmp_pa
         assert not run.stderr, run.stderr.decode()
 
 
+CONTENT_ALONE = """
+protocol: lonely
+title: Frames of content alone (no header, code, length or checksum)
+byte_order: little
+serial: {baudrate: 9600}
+framing:
+  elements:
+    content: {role: content}
+commands:
+  level: {title: Level, request: {fields: {level: {type: u8}}}}
+"""
+
+
+def test_a_frame_of_content_alone_compiles_without_a_warning(tmp_path: Path) -> None:
+    """Its unwrap has no least size to check (it wrote `n < 0u`, an error under -Wextra's -Wtype-limits)."""
+    from serialspec.lang.loader import load_text  # noqa: PLC0415
+    from serialspec.lang.resolve import resolve  # noqa: PLC0415
+
+    for path, text in c_files(resolve(load_text(CONTENT_ALONE, "lonely.yaml"))).items():
+        (tmp_path / Path(path).name).write_text(text, encoding="utf-8")
+    run = subprocess.run(
+        [GCC, *FLAGS, "-fsyntax-only", "-I", str(tmp_path), str(tmp_path / "lonely.c")], capture_output=True, text=True
+    )
+    assert run.returncode == 0 and not run.stderr, run.stderr
+
+
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
 def test_headers_compile_as_cpp11(g: Generated) -> None:
     if GXX is None:

@@ -581,10 +581,9 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
         "{",
         "    (void)values;",
         "    *code = 0u;",
-        f"    if (n < {before + after}u) {{",
-        f"        return {P}_E_LENGTH;",
-        "    }",
     ]
+    if before + after:  # (a layout of content alone: any size, and `n < 0u` is a -Wtype-limits error)
+        lines += [f"    if (n < {before + after}u) {{", f"        return {P}_E_LENGTH;", "    }"]
     for i, e in enumerate(elements):
         if e.role in ("header", "trailer", "constant"):
             for j, byte in enumerate(e.constant):

@@ -96,20 +96,20 @@ def sizes() -> Table:
         checked = _flash(folder, [str(HERE / "feetech_checked.c")], ["-DCHECKED"]) - base
         feetech = next((r for r in rows if r[0] == "feetech_sms"), None)
         if feetech is not None:  # like with like: a host's parser and decoder of responses, both sides
-            host, small = int(feetech[4]), int(feetech[5])
-            feetech[-2:] = [f"{host / hand:.2f} (small: {small / hand:.2f})", f"≤ {TARGET:.2f}"]
+            host, least = int(feetech[4]), int(feetech[5])
+            feetech[-2:] = [f"{host / hand:.2f} (small: {least / hand:.2f})", f"≤ {TARGET:.2f}"]
             rows.append(["feetech, hand-written host parser (bench/c)", "", "", "", str(hand), str(hand), *[""] * 6])
             rows.append(
                 [
                     "feetech, hand-written with the spec's checks (bench/c)",
                     *["", "", "", str(checked), str(checked)],
-                    *["", "", "", "", f"{host / checked:.2f} (small: {small / checked:.2f})", ""],
+                    *["", "", "", "", f"{host / checked:.2f} (small: {least / checked:.2f})", ""],
                 ]
             )
             notes.append(
                 f"FEETECH built for a host (responses parsed and decoded): {host / hand:.2f}× the "
-                f"hand-written host parser's flash with the default parser, {small / hand:.2f}× with the smallest "
-                f"(`P_PARSER_SMALL=1 P_PARSER_WHOLE_FRAMES=0`: {small} B; target ≤ {TARGET}×; "
+                f"hand-written host parser's flash with the default parser, {least / hand:.2f}× with the smallest "
+                f"(`P_PARSER_SMALL=1 P_PARSER_WHOLE_FRAMES=0`: {least} B; target ≤ {TARGET}×; "
                 f"both directions: {int(feetech[2]) / hand:.2f}×)."
                 " The hand-written one (feetech_handwritten.c) frames and checks packets only: no id range, and after"
                 " a bad checksum it drops the bytes it held (no resynchronisation inside a candidate); it copies the"

@@ -601,10 +601,10 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
     ]
     for i, e in enumerate(elements):
         if e.role in ("header", "trailer", "constant"):
-            test = skip if e.role == "header" else ""
+            known = skip if e.role == "header" else ""
             for j, byte in enumerate(e.constant):
                 lines.append(
-                    f"    if ({test}{_byte(start[i], j)} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */"
+                    f"    if ({known}{_byte(start[i], j)} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */"
                 )
     v = 0
     for i, e in enumerate(elements):

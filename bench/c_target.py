@@ -63,7 +63,9 @@ def sizes() -> Table:
         "encode: `P_ENABLE_DECODE=0 P_ENABLE_PARSER=0`; parser+decode: `P_ENABLE_ENCODE=0`; all: the default. "
         "host: `P_ROLE=P_ROLE_HOST` (requests out, responses in), the parser and decoder of responses alone "
         "(`P_ENABLE_ENCODE=0`) and with the encoders of requests; device: `P_ROLE=P_ROLE_DEVICE` (requests in, "
-        "responses out), everything it keeps.",
+        "responses out), everything it keeps. small: the host's parser and decoder built smallest "
+        "(`P_PARSER_SMALL=1 P_PARSER_WHOLE_FRAMES=0`, frames of the length-byte shape: FEETECH, FashionStar, "
+        "Hiwonder).",
         "Reproduce: `.venv/bin/python -m bench.run c`.",
     ]
     if shutil.which("arm-none-eabi-gcc") is None:
@@ -83,26 +85,31 @@ def sizes() -> Table:
             host_parse = _flash(folder, src, [*common, host, f"-D{up}_ENABLE_ENCODE=0"]) - base
             host_all = _flash(folder, src, [*common, host]) - base
             device_all = _flash(folder, src, [*common, device]) - base
+            small = ""  # the smallest parser (P_PARSER_SMALL, no whole-frame path), where the protocol has the switch
+            if f"#define {up}_PARSER_SMALL " in (GENERATED / name / f"{name}.h").read_text(encoding="utf-8"):
+                minimal = [f"-D{up}_ENABLE_ENCODE=0", f"-D{up}_PARSER_SMALL=1", f"-D{up}_PARSER_WHOLE_FRAMES=0"]
+                small = str(_flash(folder, src, [*common, host, *minimal]) - base)
             parser_ram, msg_ram = _ram(folder, name)
-            sizes_ = [encode, parse, both, host_parse, host_all, device_all, parser_ram, msg_ram]
+            sizes_ = [encode, parse, both, host_parse, small, host_all, device_all, parser_ram, msg_ram]
             rows.append([name, *map(str, sizes_), "", ""])
         hand = _flash(folder, [str(HERE / "feetech_handwritten.c")], ["-DHANDWRITTEN"]) - base
         checked = _flash(folder, [str(HERE / "feetech_checked.c")], ["-DCHECKED"]) - base
         feetech = next((r for r in rows if r[0] == "feetech_sms"), None)
         if feetech is not None:  # like with like: a host's parser and decoder of responses, both sides
-            host = int(feetech[4])
-            feetech[-2:] = [f"{host / hand:.2f}", f"≤ {TARGET:.2f}"]
-            rows.append(["feetech, hand-written host parser (bench/c)", "", "", "", str(hand), "", "", "", "", "", ""])
+            host, least = int(feetech[4]), int(feetech[5])
+            feetech[-2:] = [f"{host / hand:.2f} (small: {least / hand:.2f})", f"≤ {TARGET:.2f}"]
+            rows.append(["feetech, hand-written host parser (bench/c)", "", "", "", str(hand), str(hand), *[""] * 6])
             rows.append(
                 [
                     "feetech, hand-written with the spec's checks (bench/c)",
-                    *["", "", "", str(checked)],
-                    *["", "", "", "", f"{host / checked:.2f}", ""],
+                    *["", "", "", str(checked), str(checked)],
+                    *["", "", "", "", f"{host / checked:.2f} (small: {least / checked:.2f})", ""],
                 ]
             )
             notes.append(
                 f"FEETECH built for a host (responses parsed and decoded): {host / hand:.2f}× the "
-                f"hand-written host parser's flash (target ≤ {TARGET}×; "
+                f"hand-written host parser's flash with the default parser, {least / hand:.2f}× with the smallest "
+                f"(`P_PARSER_SMALL=1 P_PARSER_WHOLE_FRAMES=0`: {least} B; target ≤ {TARGET}×; "
                 f"both directions: {int(feetech[2]) / hand:.2f}×)."
                 " The hand-written one (feetech_handwritten.c) frames and checks packets only: no id range, and after"
                 " a bad checksum it drops the bytes it held (no resynchronisation inside a candidate); it copies the"
@@ -119,6 +126,7 @@ def sizes() -> Table:
         "parser+decode (B)",
         "all (B)",
         "host parser+decode (B)",
+        "host parser+decode, small (B)",
         "host all (B)",
         "device all (B)",
         "parser_t (B)",

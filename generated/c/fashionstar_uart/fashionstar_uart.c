@@ -949,38 +949,38 @@ static int fashionstar_uart__has_command(fashionstar_uart_direction_t dir, uint8
 }
 
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
-/* The request frame: unwrap, straight line. */
+/* The request frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int fashionstar_uart__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 5u) {
+    if (!sized && n < 5u) {
         return FASHIONSTAR_UART_E_LENGTH;
     }
-    if (f[0u] != 0x12u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
-    if (f[1u] != 0x4cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0x12u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0x4cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
     *code = (uint32_t)f[2u]; /* cmd_id */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
     if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
     *content = f + 4u;
     *clen = n - 5u;
     return FASHIONSTAR_UART_OK;
 }
 
-/* The response frame: unwrap, straight line. */
+/* The response frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int fashionstar_uart__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 5u) {
+    if (!sized && n < 5u) {
         return FASHIONSTAR_UART_E_LENGTH;
     }
-    if (f[0u] != 0x05u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
-    if (f[1u] != 0x1cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0x05u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0x1cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
     *code = (uint32_t)f[2u]; /* cmd_id */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
     if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
     *content = f + 4u;
     *clen = n - 5u;
@@ -996,7 +996,7 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
     case FASHIONSTAR_UART_REQUEST:
         switch (k) {
         case 0u:
-            return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen);
+            return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -1004,7 +1004,7 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
     case FASHIONSTAR_UART_RESPONSE:
         switch (k) {
         case 0u:
-            return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen);
+            return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -4510,6 +4510,36 @@ static size_t fashionstar_uart__size(fashionstar_uart_direction_t dir, const uin
     }
 }
 
+/* fashionstar_uart_decode of a candidate the parser sized (its header, the ranges of its values before the
+ * content and its length checked already): the checks left (the checksum, the content) and the message. */
+static int fashionstar_uart__take(fashionstar_uart_direction_t dir, const uint8_t *f, size_t n, fashionstar_uart_msg_t *out)
+{
+    uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS] = {0u};
+    const uint8_t *c = NULL;
+    size_t clen = 0u;
+    int r;
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        r = fashionstar_uart__unwrap_request_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    case FASHIONSTAR_UART_RESPONSE:
+        r = fashionstar_uart__unwrap_response_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    default:
+        r = FASHIONSTAR_UART_E_ARG;
+        break;
+    }
+    if (r == FASHIONSTAR_UART_OK) { /* one call, as p_decode_expect's: GCC keeps it in line */
+        r = fashionstar_uart__decode_content(dir, fashionstar_uart__has_command(dir, 0u) ? (long)code : FASHIONSTAR_UART__NO_CODE, FASHIONSTAR_UART_KIND_NONE,
+                                c, clen, values, out);
+    }
+    if (r != FASHIONSTAR_UART_OK) {
+        out->kind = FASHIONSTAR_UART_KIND_NONE;
+    }
+    return r;
+}
+
+#if !FASHIONSTAR_UART_PARSER_SMALL
 /* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
  * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
  * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
@@ -4535,7 +4565,7 @@ static int fashionstar_uart__scan(fashionstar_uart_parser_t *p, fashionstar_uart
         if (v[pos] == FASHIONSTAR_UART__C_SIZED) {
             size = fashionstar_uart__size(FASHIONSTAR_UART__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (fashionstar_uart_decode(p->buf + pos, size, FASHIONSTAR_UART__RX(p->dir), out) == FASHIONSTAR_UART_OK) {
+                if (fashionstar_uart__take(FASHIONSTAR_UART__RX(p->dir), p->buf + pos, size, out) == FASHIONSTAR_UART_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -4649,6 +4679,57 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     return 0;
 }
 
+#else
+/* FASHIONSTAR_UART_MAX_FRAME must hold a candidate's first bytes, which the small parser holds before it sizes it. */
+typedef char fashionstar_uart__max_frame_holds_a_prefix[(FASHIONSTAR_UART_MAX_FRAME >= 4u) ? 1 : -1];
+
+/* One byte in: stream.py's scan over the bytes held, at each byte (P_PARSER_SMALL: see docs/c.md). */
+static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fashionstar_uart_msg_t *out)
+{
+    uint8_t *const b = p->buf, *const end = b + p->n + 1u;
+    uint8_t *f, *hold = NULL; /* the first candidate that waits for bytes */
+    size_t size, n;
+    int got = 0;
+    end[-1] = byte;
+    for (f = b; f + 2u <= end; f++) {
+        if (!fashionstar_uart__same(f, (FASHIONSTAR_UART__RX(p->dir) == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0), 2u)) {
+            continue;
+        }
+        /* a candidate: its size, or (size_t)-1 while its first bytes have not all come */
+        size = (size_t)(end - f) >= 4u ? fashionstar_uart__size(FASHIONSTAR_UART__RX(p->dir), f) : (size_t)-1;
+        if (size == (size_t)(end - f) && fashionstar_uart__take(FASHIONSTAR_UART__RX(p->dir), f, size, out) == FASHIONSTAR_UART_OK) {
+            hold = f;
+            got = 1;
+            break;
+        }
+        if (hold == NULL) {
+            if (size > (size_t)(end - f)) {
+                hold = f;
+            } else if (size != 0u) { /* complete and corrupt (0: no frame) */
+                p->errors++;
+            }
+        }
+    }
+    if (hold == NULL) { /* keep a tail that could begin a header */
+        hold = end - 1;
+    }
+    p->garbage += (uint32_t)(hold - b);
+    n = (size_t)(end - hold);
+    for (f = b; hold < end;) { /* a loop: no library memmove */
+        *f++ = *hold++;
+    }
+    if (got) { /* the frame, now at the front of the buffer */
+        p->frames++;
+        p->frame = b;
+        p->frame_len = n;
+        n = 0u;
+    }
+    p->n = n;
+    return got;
+}
+
+#endif
+
 #if FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
@@ -4669,7 +4750,7 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
             return 0u;
         }
     }
-    if (fashionstar_uart_decode(data, size, FASHIONSTAR_UART__RX(p->dir), out) != FASHIONSTAR_UART_OK) {
+    if (fashionstar_uart__take(FASHIONSTAR_UART__RX(p->dir), data, size, out) != FASHIONSTAR_UART_OK) {
         return 0u;
     }
     p->frames++;
@@ -4710,8 +4791,10 @@ void fashionstar_uart_parser_gap(fashionstar_uart_parser_t *parser)
 {
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
+#if !FASHIONSTAR_UART_PARSER_SMALL
     parser->first = 0u;
     parser->wake = 0u;
+#endif
 }
 
 fashionstar_uart_event_t fashionstar_uart_parser_push(fashionstar_uart_parser_t *parser, uint8_t byte, fashionstar_uart_msg_t *out)

@@ -800,42 +800,42 @@ static int feetech_sms__has_command(feetech_sms_direction_t dir, uint8_t k)
 }
 
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
-/* The request frame: unwrap, straight line. */
+/* The request frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int feetech_sms__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 6u) {
+    if (!sized && n < 6u) {
         return FEETECH_SMS_E_LENGTH;
     }
-    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
-    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
     values[0] = (uint32_t)f[2u]; /* id */
-    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    if (!sized && ((values[0] > 253u) && values[0] != 254u)) { return FEETECH_SMS_E_RANGE; }
     *code = (uint32_t)f[4u]; /* instruction */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
     if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
     *content = f + 5u;
     *clen = n - 6u;
     return FEETECH_SMS_OK;
 }
 
-/* The response frame: unwrap, straight line. */
+/* The response frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int feetech_sms__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 6u) {
+    if (!sized && n < 6u) {
         return FEETECH_SMS_E_LENGTH;
     }
-    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
-    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
     values[0] = (uint32_t)f[2u]; /* id */
-    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    if (!sized && ((values[0] > 253u) && values[0] != 254u)) { return FEETECH_SMS_E_RANGE; }
     values[1] = (uint32_t)f[4u]; /* error */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
     if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
     *content = f + 5u;
     *clen = n - 6u;
@@ -851,7 +851,7 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
     case FEETECH_SMS_REQUEST:
         switch (k) {
         case 0u:
-            return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen);
+            return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -859,7 +859,7 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
     case FEETECH_SMS_RESPONSE:
         switch (k) {
         case 0u:
-            return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen);
+            return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -1623,6 +1623,36 @@ static size_t feetech_sms__size(feetech_sms_direction_t dir, const uint8_t *f)
     }
 }
 
+/* feetech_sms_decode of a candidate the parser sized (its header, the ranges of its values before the
+ * content and its length checked already): the checks left (the checksum, the content) and the message. */
+static int feetech_sms__take(feetech_sms_direction_t dir, const uint8_t *f, size_t n, feetech_sms_msg_t *out)
+{
+    uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS] = {0u};
+    const uint8_t *c = NULL;
+    size_t clen = 0u;
+    int r;
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        r = feetech_sms__unwrap_request_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    case FEETECH_SMS_RESPONSE:
+        r = feetech_sms__unwrap_response_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    default:
+        r = FEETECH_SMS_E_ARG;
+        break;
+    }
+    if (r == FEETECH_SMS_OK) { /* one call, as p_decode_expect's: GCC keeps it in line */
+        r = feetech_sms__decode_content(dir, feetech_sms__has_command(dir, 0u) ? (long)code : FEETECH_SMS__NO_CODE, FEETECH_SMS_KIND_NONE,
+                                c, clen, values, out);
+    }
+    if (r != FEETECH_SMS_OK) {
+        out->kind = FEETECH_SMS_KIND_NONE;
+    }
+    return r;
+}
+
+#if !FEETECH_SMS_PARSER_SMALL
 /* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
  * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
  * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
@@ -1648,7 +1678,7 @@ static int feetech_sms__scan(feetech_sms_parser_t *p, feetech_sms_msg_t *out)
         if (v[pos] == FEETECH_SMS__C_SIZED) {
             size = feetech_sms__size(FEETECH_SMS__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (feetech_sms_decode(p->buf + pos, size, FEETECH_SMS__RX(p->dir), out) == FEETECH_SMS_OK) {
+                if (feetech_sms__take(FEETECH_SMS__RX(p->dir), p->buf + pos, size, out) == FEETECH_SMS_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -1762,6 +1792,57 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     return 0;
 }
 
+#else
+/* FEETECH_SMS_MAX_FRAME must hold a candidate's first bytes, which the small parser holds before it sizes it. */
+typedef char feetech_sms__max_frame_holds_a_prefix[(FEETECH_SMS_MAX_FRAME >= 5u) ? 1 : -1];
+
+/* One byte in: stream.py's scan over the bytes held, at each byte (P_PARSER_SMALL: see docs/c.md). */
+static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
+{
+    uint8_t *const b = p->buf, *const end = b + p->n + 1u;
+    uint8_t *f, *hold = NULL; /* the first candidate that waits for bytes */
+    size_t size, n;
+    int got = 0;
+    end[-1] = byte;
+    for (f = b; f + 2u <= end; f++) {
+        if (f[0] != 0xffu || f[1] != 0xffu) {
+            continue;
+        }
+        /* a candidate: its size, or (size_t)-1 while its first bytes have not all come */
+        size = (size_t)(end - f) >= (FEETECH_SMS__RX(p->dir) == FEETECH_SMS_REQUEST ? 5u : 4u) ? feetech_sms__size(FEETECH_SMS__RX(p->dir), f) : (size_t)-1;
+        if (size == (size_t)(end - f) && feetech_sms__take(FEETECH_SMS__RX(p->dir), f, size, out) == FEETECH_SMS_OK) {
+            hold = f;
+            got = 1;
+            break;
+        }
+        if (hold == NULL) {
+            if (size > (size_t)(end - f)) {
+                hold = f;
+            } else if (size != 0u) { /* complete and corrupt (0: no frame) */
+                p->errors++;
+            }
+        }
+    }
+    if (hold == NULL) { /* keep a tail that could begin a header */
+        hold = end - 1;
+    }
+    p->garbage += (uint32_t)(hold - b);
+    n = (size_t)(end - hold);
+    for (f = b; hold < end;) { /* a loop: no library memmove */
+        *f++ = *hold++;
+    }
+    if (got) { /* the frame, now at the front of the buffer */
+        p->frames++;
+        p->frame = b;
+        p->frame_len = n;
+        n = 0u;
+    }
+    p->n = n;
+    return got;
+}
+
+#endif
+
 #if FEETECH_SMS_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
@@ -1782,7 +1863,7 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
             return 0u;
         }
     }
-    if (feetech_sms_decode(data, size, FEETECH_SMS__RX(p->dir), out) != FEETECH_SMS_OK) {
+    if (feetech_sms__take(FEETECH_SMS__RX(p->dir), data, size, out) != FEETECH_SMS_OK) {
         return 0u;
     }
     p->frames++;
@@ -1823,8 +1904,10 @@ void feetech_sms_parser_gap(feetech_sms_parser_t *parser)
 {
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
+#if !FEETECH_SMS_PARSER_SMALL
     parser->first = 0u;
     parser->wake = 0u;
+#endif
 }
 
 feetech_sms_event_t feetech_sms_parser_push(feetech_sms_parser_t *parser, uint8_t byte, feetech_sms_msg_t *out)

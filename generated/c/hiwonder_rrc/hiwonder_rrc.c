@@ -865,38 +865,38 @@ static int hiwonder_rrc__has_command(hiwonder_rrc_direction_t dir, uint8_t k)
 }
 
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
-/* The request frame: unwrap, straight line. */
+/* The request frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int hiwonder_rrc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 5u) {
+    if (!sized && n < 5u) {
         return HIWONDER_RRC_E_LENGTH;
     }
-    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
-    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
     *code = (uint32_t)f[2u]; /* function */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
     if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
     *content = f + 4u;
     *clen = n - 5u;
     return HIWONDER_RRC_OK;
 }
 
-/* The response frame: unwrap, straight line. */
+/* The response frame: unwrap, straight line; sized: the stream parser checked its header, values and length already. */
 static int hiwonder_rrc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
-                                 const uint8_t **content, size_t *clen)
+                                 const uint8_t **content, size_t *clen, int sized)
 {
     (void)values;
     *code = 0u;
-    if (n < 5u) {
+    if (!sized && n < 5u) {
         return HIWONDER_RRC_E_LENGTH;
     }
-    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
-    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (!sized && f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (!sized && f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
     *code = (uint32_t)f[2u]; /* function */
-    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (!sized && (int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
     if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
     *content = f + 4u;
     *clen = n - 5u;
@@ -912,7 +912,7 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
     case HIWONDER_RRC_REQUEST:
         switch (k) {
         case 0u:
-            return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen);
+            return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -920,7 +920,7 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
     case HIWONDER_RRC_RESPONSE:
         switch (k) {
         case 0u:
-            return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen);
+            return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen, 0);
         default:
             break;
         }
@@ -4430,6 +4430,36 @@ static size_t hiwonder_rrc__size(hiwonder_rrc_direction_t dir, const uint8_t *f)
     }
 }
 
+/* hiwonder_rrc_decode of a candidate the parser sized (its header, the ranges of its values before the
+ * content and its length checked already): the checks left (the checksum, the content) and the message. */
+static int hiwonder_rrc__take(hiwonder_rrc_direction_t dir, const uint8_t *f, size_t n, hiwonder_rrc_msg_t *out)
+{
+    uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS] = {0u};
+    const uint8_t *c = NULL;
+    size_t clen = 0u;
+    int r;
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        r = hiwonder_rrc__unwrap_request_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    case HIWONDER_RRC_RESPONSE:
+        r = hiwonder_rrc__unwrap_response_0(f, n, &code, values, &c, &clen, 1);
+        break;
+    default:
+        r = HIWONDER_RRC_E_ARG;
+        break;
+    }
+    if (r == HIWONDER_RRC_OK) { /* one call, as p_decode_expect's: GCC keeps it in line */
+        r = hiwonder_rrc__decode_content(dir, hiwonder_rrc__has_command(dir, 0u) ? (long)code : HIWONDER_RRC__NO_CODE, HIWONDER_RRC_KIND_NONE,
+                                c, clen, values, out);
+    }
+    if (r != HIWONDER_RRC_OK) {
+        out->kind = HIWONDER_RRC_KIND_NONE;
+    }
+    return r;
+}
+
+#if !HIWONDER_RRC_PARSER_SMALL
 /* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
  * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
  * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
@@ -4455,7 +4485,7 @@ static int hiwonder_rrc__scan(hiwonder_rrc_parser_t *p, hiwonder_rrc_msg_t *out)
         if (v[pos] == HIWONDER_RRC__C_SIZED) {
             size = hiwonder_rrc__size(HIWONDER_RRC__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {
-                if (hiwonder_rrc_decode(p->buf + pos, size, HIWONDER_RRC__RX(p->dir), out) == HIWONDER_RRC_OK) {
+                if (hiwonder_rrc__take(HIWONDER_RRC__RX(p->dir), p->buf + pos, size, out) == HIWONDER_RRC_OK) {
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -4569,6 +4599,57 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     return 0;
 }
 
+#else
+/* HIWONDER_RRC_MAX_FRAME must hold a candidate's first bytes, which the small parser holds before it sizes it. */
+typedef char hiwonder_rrc__max_frame_holds_a_prefix[(HIWONDER_RRC_MAX_FRAME >= 4u) ? 1 : -1];
+
+/* One byte in: stream.py's scan over the bytes held, at each byte (P_PARSER_SMALL: see docs/c.md). */
+static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_rrc_msg_t *out)
+{
+    uint8_t *const b = p->buf, *const end = b + p->n + 1u;
+    uint8_t *f, *hold = NULL; /* the first candidate that waits for bytes */
+    size_t size, n;
+    int got = 0;
+    end[-1] = byte;
+    for (f = b; f + 2u <= end; f++) {
+        if (f[0] != 0xaau || f[1] != 0x55u) {
+            continue;
+        }
+        /* a candidate: its size, or (size_t)-1 while its first bytes have not all come */
+        size = (size_t)(end - f) >= 4u ? hiwonder_rrc__size(HIWONDER_RRC__RX(p->dir), f) : (size_t)-1;
+        if (size == (size_t)(end - f) && hiwonder_rrc__take(HIWONDER_RRC__RX(p->dir), f, size, out) == HIWONDER_RRC_OK) {
+            hold = f;
+            got = 1;
+            break;
+        }
+        if (hold == NULL) {
+            if (size > (size_t)(end - f)) {
+                hold = f;
+            } else if (size != 0u) { /* complete and corrupt (0: no frame) */
+                p->errors++;
+            }
+        }
+    }
+    if (hold == NULL) { /* keep a tail that could begin a header */
+        hold = end - 1;
+    }
+    p->garbage += (uint32_t)(hold - b);
+    n = (size_t)(end - hold);
+    for (f = b; hold < end;) { /* a loop: no library memmove */
+        *f++ = *hold++;
+    }
+    if (got) { /* the frame, now at the front of the buffer */
+        p->frames++;
+        p->frame = b;
+        p->frame_len = n;
+        n = 0u;
+    }
+    p->n = n;
+    return got;
+}
+
+#endif
+
 #if HIWONDER_RRC_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
@@ -4589,7 +4670,7 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
             return 0u;
         }
     }
-    if (hiwonder_rrc_decode(data, size, HIWONDER_RRC__RX(p->dir), out) != HIWONDER_RRC_OK) {
+    if (hiwonder_rrc__take(HIWONDER_RRC__RX(p->dir), data, size, out) != HIWONDER_RRC_OK) {
         return 0u;
     }
     p->frames++;
@@ -4630,8 +4711,10 @@ void hiwonder_rrc_parser_gap(hiwonder_rrc_parser_t *parser)
 {
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
+#if !HIWONDER_RRC_PARSER_SMALL
     parser->first = 0u;
     parser->wake = 0u;
+#endif
 }
 
 hiwonder_rrc_event_t hiwonder_rrc_parser_push(hiwonder_rrc_parser_t *parser, uint8_t byte, hiwonder_rrc_msg_t *out)

@@ -52,6 +52,12 @@ extern "C" {
 #ifndef HIWONDER_RRC_PARSER_WHOLE_FRAMES
 #define HIWONDER_RRC_PARSER_WHOLE_FRAMES 1
 #endif
+/* 1: the smallest parser (the same results, no state but the bytes held: HIWONDER_RRC_MAX_FRAME
+ * bytes less RAM and about half the flash, slower: each byte walks the candidates held, see docs/c.md); 0: the
+ * default, faster one. */
+#ifndef HIWONDER_RRC_PARSER_SMALL
+#define HIWONDER_RRC_PARSER_SMALL 0
+#endif
 
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 260 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
@@ -603,12 +609,16 @@ typedef struct {
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
     uint32_t unknown;                 /* always 0 here: an unknown command's frame is no candidate (docs/c.md) */
+#if !HIWONDER_RRC_PARSER_SMALL
     size_t first;                     /* where the n bytes held begin in buf */
     size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
+#endif
     const uint8_t *frame;             /* the last frame delivered, as received (hiwonder_rrc_parser_frame) */
     size_t frame_len;
     uint8_t buf[HIWONDER_RRC_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
+#if !HIWONDER_RRC_PARSER_SMALL
     uint8_t verdict[HIWONDER_RRC_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, 3 corrupt */
+#endif
 } hiwonder_rrc_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */

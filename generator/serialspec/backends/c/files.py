@@ -95,12 +95,15 @@ def header(ctx: Ctx) -> str:
     )
     if length_byte.applies(protocol):
         verdict = (
+            f"#if !{P}_PARSER_SMALL\n"
             f"    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, "
-            "3 corrupt */"
+            "3 corrupt */\n#endif"
         )
         wake = (
+            f"#if !{P}_PARSER_SMALL\n"
             "    size_t first;                     /* where the n bytes held begin in buf */\n"
-            "    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */"
+            "    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */\n"
+            "#endif"
         )
     msgs = messages(protocol)
     spec_max, default_frame = max_frame(protocol)
@@ -158,7 +161,13 @@ def header(ctx: Ctx) -> str:
 """
     if length_byte.applies(protocol):  # a candidate's length is trusted only with a known command (docs/c.md)
         unknown_doc, unknown_frame = "always 0 here: an unknown command's frame is no candidate (docs/c.md)", ""
-        unknown_switch = ""
+        unknown_switch = f"""/* 1: the smallest parser (the same results, no state but the bytes held: {P}_MAX_FRAME
+ * bytes less RAM and about half the flash, slower: each byte walks the candidates held, see docs/c.md); 0: the
+ * default, faster one. */
+#ifndef {P}_PARSER_SMALL
+#define {P}_PARSER_SMALL 0
+#endif
+"""
     expect_member = (
         "" if protocol.framing.classic else f"    {p}_kind_t expect;                 /* {p}_parser_expect */\n"
     )
@@ -574,20 +583,28 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             return f"{off_a - off_b}u"
         return f"(n - {off_b + off_a}u)"
 
+    # Frames of the length-byte shape: the small parser (length_byte.small_push) calls this with `sized` for a
+    # candidate it sized, whose header, values before the content (their ranges) and length it checked already.
+    sized = length_byte.applies(ctx.protocol)
+    skip = "!sized && " if sized else ""
     lines = [
-        f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: unwrap, straight line. */",
+        f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: unwrap, straight line"
+        + ("; sized: the stream parser checked its header, values and length already. */" if sized else ". */"),
         f"static int {p}__unwrap_{direction.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,",
-        "                                 const uint8_t **content, size_t *clen)",
+        "                                 const uint8_t **content, size_t *clen" + (", int sized)" if sized else ")"),
         "{",
         "    (void)values;",
         "    *code = 0u;",
     ]
     if before + after:  # (a layout of content alone: any size, and `n < 0u` is a -Wtype-limits error)
-        lines += [f"    if (n < {before + after}u) {{", f"        return {P}_E_LENGTH;", "    }"]
+        lines += [f"    if ({skip}n < {before + after}u) {{", f"        return {P}_E_LENGTH;", "    }"]
     for i, e in enumerate(elements):
         if e.role in ("header", "trailer", "constant"):
+            known = skip if e.role == "header" else ""
             for j, byte in enumerate(e.constant):
-                lines.append(f"    if ({_byte(start[i], j)} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */")
+                lines.append(
+                    f"    if ({known}{_byte(start[i], j)} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */"
+                )
     v = 0
     for i, e in enumerate(elements):
         value = _wire_value(start[i], sizes[i], e.endian == ">")
@@ -605,7 +622,8 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
                 cond = " || ".join(test)
                 if e.broadcast is not None:
                     cond = f"({cond}) && values[{v}] != {e.broadcast}u"
-                lines.append(f"    if ({cond}) {{ return {P}_E_RANGE; }}")
+                checked = skip if i < first and len(test) else ""  # the size function tests values before content
+                lines.append(f"    if ({checked}{'(' + cond + ')' if checked else cond}) {{ return {P}_E_RANGE; }}")
             need = _need(ctx, direction, k, e)
             if need is not None:  # the variant's flag bit (its caller chose it by that bit: a check kept as Python's)
                 lines.append(f"    if ((values[{v}] & {need[0]}u) != {need[1]}u) {{ return {P}_E_RANGE; }}")
@@ -615,7 +633,7 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             a, b = names.index(e.counts[0]), names.index(e.counts[1])
             value = _wire_value(start[i], sizes[i], e.endian == ">")
             lines.append(
-                f"    if ((int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
+                f"    if ({skip}(int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
                 f"/* {e.name} */"
             )
     for i, e in enumerate(elements):
@@ -701,7 +719,8 @@ def source(ctx: Ctx) -> str:
                 straight.append(straight_unwrap(ctx, d, k, layout))
                 rows.append(
                     f"        case {k}u:\n"
-                    f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen);"
+                    f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen"
+                    + (", 0);" if length_byte.applies(protocol) else ");")
                 )
         if rows:
             unwrap_cases.append(

@@ -152,6 +152,7 @@ def parser(ctx: Ctx) -> str:
     else:
         starts = f"n >= {hl} && {p}__same(b + end - {hl}, {header}, {hl})"
     keep = max(len(layout.header) for layout in layouts.values()) - 1
+    small = small_push(ctx, need, keep)
     return f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
  * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
@@ -176,6 +177,8 @@ static size_t {p}__size({p}_direction_t dir, const uint8_t *f)
     }}
 }}
 
+{take_function(ctx)}
+#if !{P}_PARSER_SMALL
 /* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
  * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
  * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
@@ -201,7 +204,7 @@ static int {p}__scan({p}_parser_t *p, {p}_msg_t *out)
         if (v[pos] == {P}__C_SIZED) {{
             size = {p}__size({P}__RX(p->dir), p->buf + pos);
             if (pos + size <= end) {{
-                if ({p}_decode(p->buf + pos, size, {P}__RX(p->dir), out) == {P}_OK) {{
+                if ({p}__take({P}__RX(p->dir), p->buf + pos, size, out) == {P}_OK) {{
                     p->errors += errors;
                     p->garbage += (uint32_t)(pos - first);
                     p->frames++;
@@ -315,6 +318,10 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     return 0;
 }}
 
+#else
+{small}
+#endif
+
 #if {P}_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
@@ -335,7 +342,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
             return 0u;
         }}
     }}
-    if ({p}_decode(data, size, {P}__RX(p->dir), out) != {P}_OK) {{
+    if ({p}__take({P}__RX(p->dir), data, size, out) != {P}_OK) {{
         return 0u;
     }}
     p->frames++;
@@ -376,8 +383,120 @@ void {p}_parser_gap({p}_parser_t *parser)
 {{
     parser->garbage += (uint32_t)parser->n;
     parser->n = 0u;
+#if !{P}_PARSER_SMALL
     parser->first = 0u;
     parser->wake = 0u;
+#endif
 }}
 {parser_api.push_function(p, P, None)}{parser_api.frame_function(p)}{parser_api.expect_function(p, P, True)}#endif
+"""
+
+
+def small_push(ctx: Ctx, need: str, keep: int) -> str:
+    """P_PARSER_SMALL's push: the same results as the default parser's (stream.py's scan fed one byte at a time) in
+    the least flash, with no state but the bytes held. At each byte it walks the candidates held in order: the first
+    one whose last byte this is and that decodes is taken (a frame ending before this byte would have been taken at
+    its own); before the first candidate that waits for bytes, one that is no frame is dropped and one complete and
+    corrupt counted in `errors`; the bytes from that waiting candidate on (or a tail that could begin a header) are
+    kept, moved to the front of the buffer. Per byte: a header compare per byte held, a size per candidate, and each
+    candidate decoded at most once (at its last byte)."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    layouts = {d: protocol.framing.alternatives[d][0] for d in DIRECTIONS if d in protocol.framing.alternatives}
+    heads = {layout.header for layout in layouts.values()}
+    if len(heads) == 1:
+        (head,) = heads
+        width = f"{len(head)}u"
+        starts = " || ".join(f"f[{i}] != 0x{c:02x}u" for i, c in enumerate(head))
+    else:
+        width = _by_direction(protocol, P, {d: f"{len(layout.header)}u" for d, layout in layouts.items()})
+        header = _by_direction(protocol, P, {d: f"{p}__h_{d.value}_0" for d in layouts})
+        starts = f"!{p}__same(f, {header}, {width})"
+    tail = {0: "end", 1: "end - 1"}.get(keep, f"(size_t)(end - b) > {keep}u ? end - {keep}u : b")
+    most = max(prefix(layout) for layout in layouts.values())
+    return f"""/* {P}_MAX_FRAME must hold a candidate's first bytes, which the small parser holds before it sizes it. */
+typedef char {p}__max_frame_holds_a_prefix[({P}_MAX_FRAME >= {most}u) ? 1 : -1];
+
+/* One byte in: stream.py's scan over the bytes held, at each byte (P_PARSER_SMALL: see docs/c.md). */
+static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
+{{
+    uint8_t *const b = p->buf, *const end = b + p->n + 1u;
+    uint8_t *f, *hold = NULL; /* the first candidate that waits for bytes */
+    size_t size, n;
+    int got = 0;
+    end[-1] = byte;
+    for (f = b; f + {width} <= end; f++) {{
+        if ({starts}) {{
+            continue;
+        }}
+        /* a candidate: its size, or (size_t)-1 while its first bytes have not all come */
+        size = (size_t)(end - f) >= {need} ? {p}__size({P}__RX(p->dir), f) : (size_t)-1;
+        if (size == (size_t)(end - f) && {p}__take({P}__RX(p->dir), f, size, out) == {P}_OK) {{
+            hold = f;
+            got = 1;
+            break;
+        }}
+        if (hold == NULL) {{
+            if (size > (size_t)(end - f)) {{
+                hold = f;
+            }} else if (size != 0u) {{ /* complete and corrupt (0: no frame) */
+                p->errors++;
+            }}
+        }}
+    }}
+    if (hold == NULL) {{ /* keep a tail that could begin a header */
+        hold = {tail};
+    }}
+    p->garbage += (uint32_t)(hold - b);
+    n = (size_t)(end - hold);
+    for (f = b; hold < end;) {{ /* a loop: no library memmove */
+        *f++ = *hold++;
+    }}
+    if (got) {{ /* the frame, now at the front of the buffer */
+        p->frames++;
+        p->frame = b;
+        p->frame_len = n;
+        n = 0u;
+    }}
+    p->n = n;
+    return got;
+}}
+"""
+
+
+def take_function(ctx: Ctx) -> str:
+    """p__take: p_decode of a candidate the parser sized, without the checks the sizing made (the straight unwrap's
+    `sized`), so a parser-only build links no p_decode_expect."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    layouts = {d: protocol.framing.alternatives[d][0] for d in DIRECTIONS if d in protocol.framing.alternatives}
+    cases = []
+    for d in layouts:
+        cases += [
+            f"    case {P}_{d.name}:",
+            f"        r = {p}__unwrap_{d.value}_0(f, n, &code, values, &c, &clen, 1);",
+            "        break;",
+        ]
+    take_cases = "\n".join(cases)
+    return f"""/* {p}_decode of a candidate the parser sized (its header, the ranges of its values before the
+ * content and its length checked already): the checks left (the checksum, the content) and the message. */
+static int {p}__take({p}_direction_t dir, const uint8_t *f, size_t n, {p}_msg_t *out)
+{{
+    uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
+    const uint8_t *c = NULL;
+    size_t clen = 0u;
+    int r;
+    switch (dir) {{
+{take_cases}
+    default:
+        r = {P}_E_ARG;
+        break;
+    }}
+    if (r == {P}_OK) {{ /* one call, as p_decode_expect's: GCC keeps it in line */
+        r = {p}__decode_content(dir, {p}__has_command(dir, 0u) ? (long)code : {P}__NO_CODE, {P}_KIND_NONE,
+                                c, clen, values, out);
+    }}
+    if (r != {P}_OK) {{
+        out->kind = {P}_KIND_NONE;
+    }}
+    return r;
+}}
 """

@@ -149,7 +149,10 @@ def readme(ctx: Ctx) -> str:
         f"| `{P}_ENABLE_DECODE` | 1 | the decoders (the parser needs them) |",
         f"| `{P}_ENABLE_PARSER` | 1 | the stream parser |",
         *(
-            []
+            [
+                f"| `{P}_PARSER_SMALL` | 0 | 1: the smallest stream parser (the same frames and counters, no state but "
+                f"the bytes held: `{P}_MAX_FRAME` bytes less RAM, about half the flash, slower) |"
+            ]
             if length_byte.applies(ctx.protocol)
             else [
                 f"| `{P}_PARSER_UNKNOWN_FRAMES` | 1 | `{P}_EVENT_FRAME_UNKNOWN` and the copy of that frame in the "

@@ -462,7 +462,7 @@ def test_generate_takes_a_shipped_protocol_by_name_outside_any_project(tmp_path:
 
 def test_every_option_says_what_it_takes_and_what_it_does() -> None:
     # `--timeout S`, `--speed X`, `--port PORT`: never argparse's `--timeout TIMEOUT`, nor an option without help
-    from serialspec.cli import VERBS, build_parser
+    from serialspec.cli.arguments import VERBS, build_parser
 
     _, verbs = build_parser(VERBS)
     unnamed = []

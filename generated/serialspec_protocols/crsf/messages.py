@@ -453,7 +453,7 @@ class RcChannelsRequest(Message):
         cls,
         channels: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (tuple(channels),))
+        return _build(cls, (tuple(channels) if isinstance(channels, list) else channels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -484,7 +484,7 @@ class RcChannelsResponse(Message):
         cls,
         channels: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (tuple(channels),))
+        return _build(cls, (tuple(channels) if isinstance(channels, list) else channels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {

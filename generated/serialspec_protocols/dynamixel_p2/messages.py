@@ -732,7 +732,7 @@ class SyncReadRequest(Message):
         length: int,
         ids: tuple[IdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, tuple(ids)))
+        return _build(cls, (id, address, length, tuple(ids) if isinstance(ids, list) else ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -778,7 +778,7 @@ class FastSyncReadRequest(Message):
         length: int,
         servo_ids: tuple[ServoIdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, tuple(servo_ids)))
+        return _build(cls, (id, address, length, tuple(servo_ids) if isinstance(servo_ids, list) else servo_ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -821,7 +821,7 @@ class SyncWriteRequest(Message):
         address: int,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, tuple(servos)))
+        return _build(cls, (id, address, tuple(servos) if isinstance(servos, list) else servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -859,7 +859,7 @@ class BulkReadRequest(Message):
         id: int,
         reads: tuple[ReadsItem, ...],
     ) -> Self:
-        return _build(cls, (id, tuple(reads)))
+        return _build(cls, (id, tuple(reads) if isinstance(reads, list) else reads))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -895,7 +895,7 @@ class BulkWriteRequest(Message):
         id: int,
         writes: tuple[WritesItem, ...],
     ) -> Self:
-        return _build(cls, (id, tuple(writes)))
+        return _build(cls, (id, tuple(writes) if isinstance(writes, list) else writes))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -1939,7 +1939,7 @@ class SyncCommandRequest(Message):
         command: int,
         blocks: tuple[BlocksItem, ...],
     ) -> Self:
-        return _build(cls, (command, tuple(blocks)))
+        return _build(cls, (command, tuple(blocks) if isinstance(blocks, list) else blocks))
 
     def to_fields(self) -> dict[str, Any]:
         return {

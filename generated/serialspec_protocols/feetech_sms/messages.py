@@ -422,7 +422,7 @@ class SyncReadRequest(Message):
         length: int,
         ids: tuple[IdsItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, length, tuple(ids)))
+        return _build(cls, (id, address, length, tuple(ids) if isinstance(ids, list) else ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -465,7 +465,7 @@ class SyncWriteRequest(Message):
         address: int,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (id, address, tuple(servos)))
+        return _build(cls, (id, address, tuple(servos) if isinstance(servos, list) else servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -514,7 +514,7 @@ class MotorSetSpeedsRequest(Message):
         cls,
         motors: tuple[MotorsItem, ...],
     ) -> Self:
-        return _build(cls, (tuple(motors),))
+        return _build(cls, (tuple(motors) if isinstance(motors, list) else motors,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -581,7 +581,7 @@ class MotorSetDutiesRequest(Message):
         cls,
         duties: tuple[DutiesItem, ...],
     ) -> Self:
-        return _build(cls, (tuple(duties),))
+        return _build(cls, (tuple(duties) if isinstance(duties, list) else duties,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -651,7 +651,7 @@ class PwmServoSetPositionsRequest(Message):
         duration: int,
         pwm_servos: tuple[PwmServosItem, ...],
     ) -> Self:
-        return _build(cls, (duration, tuple(pwm_servos)))
+        return _build(cls, (duration, tuple(pwm_servos) if isinstance(pwm_servos, list) else pwm_servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -913,7 +913,7 @@ class BusServoSetPositionsRequest(Message):
         duration: int,
         bus_servos: tuple[BusServosItem, ...],
     ) -> Self:
-        return _build(cls, (duration, tuple(bus_servos)))
+        return _build(cls, (duration, tuple(bus_servos) if isinstance(bus_servos, list) else bus_servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1177,7 +1177,7 @@ class BusServoStopRequest(Message):
         cls,
         servos: tuple[ServosItem, ...],
     ) -> Self:
-        return _build(cls, (tuple(servos),))
+        return _build(cls, (tuple(servos) if isinstance(servos, list) else servos,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2136,7 +2136,7 @@ class SbusResponse(Message):
         signal_loss: int,
         fail_safe: int,
     ) -> Self:
-        return _build(cls, (tuple(channels), ch17, ch18, signal_loss, fail_safe))
+        return _build(cls, (tuple(channels) if isinstance(channels, list) else channels, ch17, ch18, signal_loss, fail_safe))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2246,7 +2246,7 @@ class RgbSetPixelsRequest(Message):
         cls,
         pixels: tuple[PixelsItem, ...],
     ) -> Self:
-        return _build(cls, (tuple(pixels),))
+        return _build(cls, (tuple(pixels) if isinstance(pixels, list) else pixels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {

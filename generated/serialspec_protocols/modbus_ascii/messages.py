@@ -141,7 +141,7 @@ class ReadCoilsResponse(Message):
         unit: int,
         coils: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, tuple(coils)))
+        return _build(cls, (unit, tuple(coils) if isinstance(coils, list) else coils))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -220,7 +220,7 @@ class ReadDiscreteInputsResponse(Message):
         unit: int,
         inputs: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, tuple(inputs)))
+        return _build(cls, (unit, tuple(inputs) if isinstance(inputs, list) else inputs))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -299,7 +299,7 @@ class ReadHoldingRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, tuple(registers)))
+        return _build(cls, (unit, tuple(registers) if isinstance(registers, list) else registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -378,7 +378,7 @@ class ReadInputRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, tuple(registers)))
+        return _build(cls, (unit, tuple(registers) if isinstance(registers, list) else registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -583,7 +583,7 @@ class WriteCoilsRequest(Message):
         address: int,
         values: tuple[bool, ...],
     ) -> Self:
-        return _build(cls, (unit, address, tuple(values)))
+        return _build(cls, (unit, address, tuple(values) if isinstance(values, list) else values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -668,7 +668,7 @@ class WriteRegistersRequest(Message):
         address: int,
         values: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, address, tuple(values)))
+        return _build(cls, (unit, address, tuple(values) if isinstance(values, list) else values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -851,7 +851,7 @@ class ReadWriteRegistersRequest(Message):
         write_address: int,
         values: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, read_address, read_count, write_address, tuple(values)))
+        return _build(cls, (unit, read_address, read_count, write_address, tuple(values) if isinstance(values, list) else values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -896,7 +896,7 @@ class ReadWriteRegistersResponse(Message):
         unit: int,
         registers: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (unit, tuple(registers)))
+        return _build(cls, (unit, tuple(registers) if isinstance(registers, list) else registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {

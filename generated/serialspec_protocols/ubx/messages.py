@@ -1045,7 +1045,7 @@ class CfgValgetRequest(Message):
         position: int,
         keys: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (layer, position, tuple(keys)))
+        return _build(cls, (layer, position, tuple(keys) if isinstance(keys, list) else keys))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1155,7 +1155,7 @@ class MonVerResponse(Message):
         hw_version: str,
         extensions: tuple[ExtensionsItem, ...],
     ) -> Self:
-        return _build(cls, (sw_version, hw_version, tuple(extensions)))
+        return _build(cls, (sw_version, hw_version, tuple(extensions) if isinstance(extensions, list) else extensions))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -10,31 +10,6 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
     import argparse
 
-DESCRIPTION = (
-    "serial protocols as YAML specs: generate codecs, typed clients, virtual devices and references from them; "
-    "decode, encode, simulate and watch frames"
-)
-# Each verb (its module, serialspec.cli.<verb>, is imported only to run it: `generate` loads no serial-port code)
-# and its one-line help.
-VERBS = {
-    "generate": "generate DIR/<protocol>/ and DIR/docs/<protocol>.md from specs "
-    "(default: the project's, see [tool.serialspec])",
-    "check": "check the specs and that the generated files match them (exit 1 naming each stale or orphaned file)",
-    "decode": "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'), one frame per argument "
-    "('-': one per line from stdin), or a capture with --file",
-    "encode": "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex",
-    "sim": "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped",
-    "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
-    "docs": "build a documentation site (mkdocs) of specs: each protocol's reference and its spec, searchable",
-    "plot": "plot fields over time in their units, one panel each, from a capture or live from a port (PNG, SVG)",
-    "ports": "list the serial ports: device path, description, VID:PID and serial number",
-    "scan": "find the devices on a bus: each id (and baud rate) answering the spec's presence request, with its model",
-    "replay": "send the frames of one direction of a capture to a port, with their timing",
-    "completion": "print the shell completion script for bash, zsh or fish",
-    "watch": "a live full-screen view of a port: one row per device and command, last values in units, rates, errors",
-    "export": "write captures (monitor --save, sim --tap) as one pcap file for Wireshark (generate --target wireshark)",
-}
-
 
 def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
     """The command's argparse parser with the arguments of the `chosen` verbs, and each verb's own parser

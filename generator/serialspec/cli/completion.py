@@ -20,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import shtab
 
-    from serialspec.cli import VERBS, build_parser
+    from serialspec.cli.arguments import VERBS, build_parser
 
     parser, _ = build_parser(VERBS)
     for action in _actions(parser):

@@ -9,7 +9,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from serialspec.cli.protocols import SHIPPED_SPEC, SPEC_HELP, open_spec, shipped_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.shipped import SHIPPED_SPEC, shipped_spec
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import SerialspecError
 

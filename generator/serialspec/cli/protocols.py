@@ -13,18 +13,13 @@ import os
 import sys
 from types import ModuleType
 
+from serialspec.cli.shipped import SHIPPED_NAMESPACE, SHIPPED_SPEC, import_name
 from serialspec.runtime.errors import SerialspecError
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
-    from pathlib import Path
-
     from serialspec.lang.model import Protocol
 
-SHIPPED_SPEC = "spec.yaml"
-#: Where serialspec's own protocol packages are installed (the repository's pyproject.toml `namespace`): a protocol
-#: name is looked up there too, so `serialspec decode vesc …` needs no namespace.
-SHIPPED_NAMESPACE = "serialspec_protocols"
 SPEC_HELP = (
     "a spec file (built from it in memory, never stale), or a generated protocol package's name (in the current "
     "folder or installed)"
@@ -186,50 +181,13 @@ def _in_project(name: str) -> ModuleType | None:
         sys.path.remove(folder)
 
 
-def shipped_spec(name: str) -> Path | None:
-    """The spec a generated protocol package NAME ships (found as `installed` finds the package, without importing
-    it), for the verbs that read spec files (`generate`, `docs`); None when there is no such package."""
-    from pathlib import Path
-
-    if not name.isidentifier():
-        return None
-    here = str(Path.cwd())
-    sys.path.insert(0, here)
-    import importlib.util
-
-    try:
-        found = importlib.util.find_spec(_import_name(name))
-    except (ImportError, ValueError):
-        found = None
-    finally:
-        sys.path.remove(here)
-    if found is None or not found.submodule_search_locations:
-        return None
-    shipped = Path(next(iter(found.submodule_search_locations)), SHIPPED_SPEC)
-    return shipped if shipped.is_file() else None
-
-
-def _import_name(name: str) -> str:
-    """The name to import a protocol's package by (the current folder is on the path): the folder's own package,
-    else the shipped one under its namespace (not the old top-level alias, which warns), else NAME as it is."""
-    if not name.isidentifier() or os.path.isfile(os.path.join(name, "__init__.py")):
-        return name
-    import importlib.util
-
-    try:
-        shipped = importlib.util.find_spec(f"{SHIPPED_NAMESPACE}.{name}")
-    except ImportError:
-        shipped = None
-    return f"{SHIPPED_NAMESPACE}.{name}" if shipped is not None else name
-
-
 def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None:
     """The importable generated package of this protocol, if it was generated from exactly this spec text (the copy
     of the spec it ships says so); else None, and the caller builds the package from the spec instead."""
     import importlib.util
     from pathlib import Path
 
-    name = _import_name(protocol.name)
+    name = import_name(protocol.name)
     try:
         found = importlib.util.find_spec(name)
     except (ImportError, ValueError):

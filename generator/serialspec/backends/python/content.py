@@ -133,9 +133,12 @@ class Attribute:
 
     @property
     def stored(self) -> str:
-        """The value the constructor stores: a sequence field's items as a tuple (a list given stays no list, so the
-        message equals the one `decode` gives for its frame); tuple() of a tuple is the tuple itself, ~40 ns."""
-        return f"tuple({self.name})" if self.annotation.startswith("tuple[") else self.name
+        """The value the constructor stores: a list given for a sequence field as a tuple (so the message equals the
+        one `decode` gives for its frame); anything else as given, for encode to check and name (a string or a
+        record is no list of items, and iterating it would hide that)."""
+        if self.annotation.startswith("tuple["):
+            return f"tuple({self.name}) if isinstance({self.name}, list) else {self.name}"
+        return self.name
 
 
 @dataclass

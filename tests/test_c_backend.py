@@ -471,7 +471,7 @@ def check_decode_agrees(g: Generated, frame: bytes, direction: Direction) -> Non
 
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
 def test_random_bytes_are_refused_or_decoded_as_python_does(g: Generated) -> None:
-    @settings(max_examples=examples(60), deadline=None)
+    @settings(max_examples=examples(40), deadline=None)
     @given(st.binary(max_size=24), st.sampled_from(list(g.protocol.framing.layouts)))
     def agree(frame: bytes, direction: Direction) -> None:
         header = g.protocol.framing.layouts[direction].header
@@ -785,7 +785,7 @@ def test_the_checked_hand_written_baseline_reads_replies_as_python_where_no_fram
         st.binary(max_size=5).map(lambda b: b.replace(b"\xff", b"")),  # garbage (no header byte)
     )
 
-    @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(20), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.lists(piece, max_size=8).map(b"".join))
     def agree(stream: bytes) -> None:
         checked, python = both(stream)

@@ -109,7 +109,7 @@ def test_construct_struct_agrees_on_every_example(g: Generated, example: Example
 def test_random_valid_messages_round_trip_and_agree_with_construct(g: Generated, spec: Message) -> None:
     cls = message_type(g, spec)
 
-    @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(20), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), requests(g, spec))
     def round_trip(fields: dict[str, Any], request: Any) -> None:
         frame = encode(g, cls.from_fields(fields), request)
@@ -139,7 +139,7 @@ def test_out_of_range_values_are_refused_naming_field_and_range(g: Generated, sp
     bounded = bounded_fields(spec)
     request = a_request(g, spec)
 
-    @settings(max_examples=examples(20), deadline=None)
+    @settings(max_examples=examples(12), deadline=None)
     @given(message_fields(g.protocol, spec), st.data())
     def refused(fields: dict[str, Any], data: st.DataObject) -> None:
         target = data.draw(st.sampled_from(bounded))

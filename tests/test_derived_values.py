@@ -242,7 +242,7 @@ def test_c_computes_every_expression_as_python_does(value: str, b_type: str, che
 def agree_all(run: Driver, package: Any, expr: expression.Expr, b_range: tuple[int, int], b_type: str) -> None:
     """The Python package and the C driver agree on random fields and frames."""
 
-    @settings(max_examples=examples(150), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(80), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.integers(-32768, 32767), st.integers(*b_range), st.integers(-(1 << 63), (1 << 64) - 1), st.integers(0, 2))
     def agree(a: int, b: int, check: int, how: int) -> None:
         try:

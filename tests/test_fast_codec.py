@@ -46,7 +46,7 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         all(e.role != "checksum" for e in other.elements) for other in g.protocol.framing.alternatives[spec.direction]
     )
 
-    @settings(max_examples=examples(20), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), requests(g, spec))
     def agree(fields: dict[str, Any], request: Any) -> None:
         built = cls.from_fields(fields)  # through the dataclass __init__

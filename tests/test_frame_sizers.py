@@ -60,7 +60,7 @@ def test_a_sizer_answers_as_probe(g: Generated, name: str, codec: FrameCodec) ->
     special = sorted({b for layout in codec.layouts for b in layout.header + layout.trailer} | codes)
     special = [b for b in special if 0 <= b < 256]
 
-    @settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(100), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(candidate(frames, special))
     def run(drawn: tuple[bytes, int, int]) -> None:
         buffer, start, end = drawn

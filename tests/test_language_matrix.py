@@ -1021,7 +1021,7 @@ def test_the_clients_of_every_case_pass_ruff(tmp_path: Path) -> None:
     assert ruff.returncode == 0, ruff.stdout + ruff.stderr
 
 
-SETTINGS = settings(max_examples=examples(8), deadline=None, suppress_health_check=list(HealthCheck))
+SETTINGS = settings(max_examples=examples(6), deadline=None, suppress_health_check=list(HealthCheck))
 
 
 def requesting(g: Generated) -> bool:

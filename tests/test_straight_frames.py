@@ -194,7 +194,7 @@ def check_agreement(codec: ModuleType, direction: str, data: st.DataObject) -> N
 
 @pytest.mark.parametrize("direction", ["request", "response"])
 @pytest.mark.parametrize("name", SHIPPED)
-@settings(max_examples=examples(150), suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(100), suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_shipped_codecs_agree_with_the_engine(name: str, direction: str, data: st.DataObject) -> None:
     codec = pytest.importorskip(f"{name}.codec")
@@ -203,7 +203,7 @@ def test_shipped_codecs_agree_with_the_engine(name: str, direction: str, data: s
 
 @pytest.mark.parametrize("direction", ["request", "response"])
 @pytest.mark.parametrize("name", ["slip_like", "inner_checksum"])
-@settings(max_examples=examples(150), suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(100), suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_specs_with_other_framings_agree_with_the_engine(
     custom: dict[str, ModuleType], name: str, direction: str, data: st.DataObject
@@ -251,7 +251,7 @@ LENGTH_BYTE = [g for g in ALL if g.protocol.text is None and g.protocol.framing.
 
 @pytest.mark.parametrize("direction", ["request", "response"])
 @pytest.mark.parametrize("g", LENGTH_BYTE, ids=[g.protocol.name for g in LENGTH_BYTE])
-@settings(max_examples=examples(150), suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(100), suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_length_byte_codecs_agree_with_the_engine(g: Generated, direction: str, data: st.DataObject) -> None:
     """A length-byte codec's decode() (its whole-frame tables first, then the checks frames/ writes for every
@@ -287,7 +287,7 @@ def test_encoders_make_the_frames_the_engine_makes(g: Generated, spec: Message) 
 
     by_command = g.protocol.framing.by_command  # layouts chosen by command: wrap in the one the frame was read in
 
-    @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(20), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), requests(g, spec))
     def same_bytes(fields: dict[str, Any], request: Any) -> None:
         frame = encode(g, cls.from_fields(fields), request)

@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from conftest import Generated
+from conftest import Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.message import Direction, Message
@@ -86,7 +86,7 @@ def fed(parser: StreamParser, chunks: list[bytes]) -> tuple[list[Message], tuple
 @pytest.mark.parametrize(("g", "direction"), LEAN, ids=IDS)
 def test_every_split_takes_what_the_byte_by_byte_scan_takes(g: Generated, direction: Direction) -> None:
     @given(st.data())
-    @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(80), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     def check(data: st.DataObject) -> None:
         stream = data.draw(damaged(g, direction))
         expected = fed(scanning(g.package.StreamParser(direction)), [stream])
@@ -143,7 +143,7 @@ def test_reads_of_one_key_take_what_the_byte_by_byte_scan_takes(
     header = g.protocol.framing.layouts[direction].header
 
     @given(st.data())
-    @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(80), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     def check(data: st.DataObject) -> None:
         parts: list[bytes] = []
         for _ in range(data.draw(st.integers(1, 80))):

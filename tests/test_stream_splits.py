@@ -165,7 +165,7 @@ def splits(draw: st.DrawFn, data: bytes) -> list[bytes]:
 
 @pytest.mark.parametrize(("g", "direction"), PARSERS, ids=IDS)
 def test_every_split_gives_the_frames_that_complete_first(g: Generated, direction: Direction | None) -> None:
-    @settings(max_examples=examples(30), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(20), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.data())
     def run(drawn: st.DataObject) -> None:
         waiting = drawn.draw(awaited(g, direction))
@@ -190,7 +190,7 @@ def test_a_frame_comes_out_with_the_read_that_completes_it(g: Generated, directi
     changes and just before it (frames of a longer stream start with those of a shorter one, so between those
     positions one read gives no more and no fewer)."""
 
-    @settings(max_examples=examples(15), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(10), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.data())
     def run(drawn: st.DataObject) -> None:
         waiting = drawn.draw(awaited(g, direction))

@@ -46,7 +46,7 @@ def test_codec_and_structs_accept_the_same_changed_contents(g: Generated, spec: 
     cls = message_type(g, spec)
     whole = Struct("content" / g.structs.CONTENTS[(spec.key, spec.direction.value)], Terminated)
 
-    @settings(max_examples=examples(100), deadline=None, suppress_health_check=list(HealthCheck))
+    @settings(max_examples=examples(60), deadline=None, suppress_health_check=list(HealthCheck))
     @given(message_fields(g.protocol, spec), st.data())
     def run(fields: dict[str, Any], data: st.DataObject) -> None:
         frame = g.package.encode(cls.from_fields(fields))

@@ -335,6 +335,21 @@ def test_check_of_a_spec_of_ones_own_names_the_generate_that_brings_it_up_to_dat
     assert serialspec("check", "my lamp.yaml", "--out", ".", cwd=tmp_path).returncode == 0
 
 
+def test_check_of_a_spec_with_a_mistake_says_to_fix_it_before_generating(tmp_path: Path) -> None:
+    """With a mistake in the spec, the hint sent the user to `generate`, which refuses the spec just the same."""
+    text = (ROOT / "examples" / "tinylamp" / "tinylamp.yaml").read_text(encoding="utf-8")
+    (tmp_path / "lamp.yaml").write_text(text.replace("protocol: tinylamp", "protocol: tinylamp\nbogus: 1"), "utf-8")
+    checked = serialspec("check", "lamp.yaml", "--out", ".", cwd=tmp_path)
+    assert checked.returncode == 1
+    lines = checked.stderr.splitlines()
+    assert lines[0].startswith("lamp.yaml:5:") and "unknown key 'bogus'" in lines[0]
+    assert (
+        lines[-1]
+        == "fix the mistakes above, then run `serialspec generate lamp.yaml --out .` to bring the generated files "
+        "up to date"
+    )
+
+
 def test_an_output_folder_outside_the_project_is_shown_as_it_was_named(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -229,6 +229,13 @@ CASES: dict[str, Case] = {
         },
         request_keys={"answered_by": {"command": "ack", "refused_by": ["nak"]}},
     ),
+    "answered_by command_in (a request asking for any command's reply by its code)": Case(
+        {},  # the device answers a command asked for as that command's request with no content
+        {"v": "u8", "w": "i16"},
+        commands={
+            "ask": {"code": 7, "request": {"fields": {"wanted": "u16"}, "answered_by": {"command_in": "wanted"}}}
+        },
+    ),
     # frame shapes: every element role, multi-byte elements in both byte orders, stuffing, alternative layouts
     "frame: trailer, constant, u16 big-endian length and checksum": Case(
         {"v": "u16"},
@@ -1160,6 +1167,15 @@ def client_against_simulator(g: Generated) -> None:
                 fields = {**fields, **{e.name: device for e in addresses}}
                 reply = bus.request(message_class(g, request).from_fields(fields), message_class(g, response))
                 assert type(reply) is message_class(g, response)
+        asking = [m for m in g.protocol.messages() if m.asks_in]
+        if asking:  # the generated method of a request that asks for probe's reply by probe's code
+            client_class = next(v for k, v in vars(client_module).items() if k.endswith("Client") and k != "Client")
+            with client_class(path, timeout=1.0) as client:
+                for m in asking:
+                    method = getattr(client, m.key)
+                    assert type(method(**{e.name: device for e in addresses}, **{m.asks_in: 1})) is message_class(
+                        g, response
+                    )
     finally:
         simulator.close()
 

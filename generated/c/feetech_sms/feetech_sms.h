@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "bc05824507a2b97ed0c3e7b70bc3aa455e55aee705a57f829af49017ba1eaa56"
+#define FEETECH_SMS_SPEC_SHA256 "9dfc281b066345f47fb840be57a0ae73c5c71bebd52de48f905b0dbc7312cdd6"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "499296f4a990bfb97dd94d3871d8af47f1204d7bf93c0e8c0b45062ce6dba6fe"
+#define HIWONDER_RRC_SPEC_SHA256 "60304d613671e67aaf875409f103ef00b1374953fe4eaa31018bfe9762e7f03b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "83705f750c0fdf5a5dd6b74343ffc67a73953133d627ec18cc79ea4aede70456"
+#define MAVLINK_COMMON_SPEC_SHA256 "e31b43aaa6a38899a04df84915307f5d400ccfb5ba24ec4ea5824c13f4917576"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

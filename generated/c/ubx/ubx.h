@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "d9182d951a01f9bbfa80af95345bb13521253dc66d93c23603d015083fbb5535"
+#define UBX_SPEC_SHA256 "013a54414ae9ab6830693abaeb3fe21b1594513b102959c18c7dea81ceda00a6"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

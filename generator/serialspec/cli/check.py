@@ -43,8 +43,9 @@ def run(args: argparse.Namespace) -> int:
         problems.append(f"{proj.display(path)}: not generated from any spec (move it out of the generated package)")
     for problem in [*shown(errors), *problems]:
         print(problem, file=sys.stderr)
-    if problems:  # a file to regenerate, not only mistakes in specs
-        print(f"run `{generate_command(args)}` to bring the generated files up to date", file=sys.stderr)
+    if problems:  # a file to regenerate, not only mistakes in specs (which generate refuses until they are fixed)
+        first = "fix the mistakes above, then run" if errors else "run"
+        print(f"{first} `{generate_command(args)}` to bring the generated files up to date", file=sys.stderr)
     if problems or errors:
         return 1
     print(f"{len(files)} generated {'file matches' if len(files) == 1 else 'files match'} the specs")

@@ -547,6 +547,14 @@ MESSAGE = Obj(
         "answered_by": Obj(
             {
                 "command": Str("The command whose response answers this request (one reply layout for many)."),
+                "command_in": Str(
+                    "Instead of `command`: the request's integer field holding the code of the command whose "
+                    "response answers it (Blue Robotics Ping's general_request: `requested_id`; a request for any "
+                    "message). The client's method returns that command's reply, and refuses a code no command with "
+                    "a response has before a byte is written; the simulator acts on it as on that command's request "
+                    "sent with no content (`decode` and the stream parser read the reply by its own code).",
+                    example="requested_id",
+                ),
                 "refused_by": ListOf(
                     Str(),
                     "Commands whose responses refuse this request instead (u-blox ACK-NAK): the client waits for "
@@ -555,9 +563,9 @@ MESSAGE = Obj(
                 ),
                 "optional_when": OPTIONAL_WHEN,
             },
-            required=("command",),
             description="For a request: answered by another command's response (FEETECH's one status packet; in text "
-            "frames GRBL's `ok`, with `refused_by: [error]`).",
+            "frames GRBL's `ok`, with `refused_by: [error]`), named by `command`, or by the code a request field "
+            "holds (`command_in`).",
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
@@ -1272,7 +1280,11 @@ DEVICE_COMMAND = Obj(
             "REG WRITE: error.number 2, instruction error).",
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
-        "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "stores": MapOf(
+            Str(),
+            "Request field -> the state variable it is stored in (`{origin: asker}`, or the same name: a request "
+            "field is stored only where `stores` or `writes` names it).",
+        ),
         "echoes": ListOf(
             Str(),
             "Response fields that repeat the request's field of the same name (a write's reply confirming what was "

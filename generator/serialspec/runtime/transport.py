@@ -26,7 +26,16 @@ from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, EchoMismatch, EncodeError, PortError, Timeout, shown
+from serialspec.runtime.errors import (
+    CorruptReply,
+    DeviceError,
+    EchoMismatch,
+    EncodeError,
+    PortError,
+    RangeError,
+    Timeout,
+    shown,
+)
 from serialspec.runtime.message import Direction, Message, Record, takes_request
 from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
@@ -153,6 +162,16 @@ def table_key(table: dict[str, int], name: str) -> int:
         return table[name]
     except KeyError:
         raise EncodeError(f"unknown entry {name!r} (expected one of {', '.join(table)})") from None
+
+
+def asked_reply(replies: Mapping[int, type[Message]], command: str, field_name: str, code: object) -> type[Message]:
+    """The reply a request asking for a command by its code gets (`answered_by: {command_in: FIELD}`), refused
+    before a byte is written when no command with a reply has that code."""
+    found = replies.get(code) if isinstance(code, int) and not isinstance(code, bool) else None
+    if found is None:
+        known = ", ".join(str(c) for c in sorted(replies))
+        raise RangeError(f"{command}: {field_name} = {code!r} is the code of no command with a reply (one of {known})")
+    return found
 
 
 def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:

@@ -296,12 +296,14 @@ def reply_text(message: Message, protocol: Protocol | None = None) -> str:
         if message.request_code:
             parts.append(f"`{message.request_code}` holds the code of the request it answers")
         return "; ".join(p for p in parts if p)
-    if not message.answered_by and not message.refused_by:
+    if not message.answered_by and not message.asks_in and not message.refused_by:
         return ""
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     refusals = ", ".join(f"`{name}`" for name in message.refused_by)
     refused = f"; refused by the {refusals} response (the client raises DeviceError)" if refusals else ""
+    if message.asks_in:
+        return f"answered by the response of the command whose code `{message.asks_in}` holds{when}{refused}"
     return f"answered by the `{message.answered_by or message.key}` response{when}{refused}"
 
 

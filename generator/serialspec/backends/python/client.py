@@ -22,7 +22,7 @@ from __future__ import annotations
 from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
-from serialspec.backends.common.pairing import request_response_pairs
+from serialspec.backends.common.pairing import asked_commands, request_response_pairs
 from serialspec.backends.python.content import annotation
 from serialspec.backends.python.kinds import list_item_type
 from serialspec.backends.python.registers import map_name, names_alias
@@ -475,7 +475,9 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         optional = reply_condition(request, response)
         if optional:
             optional_keys.add(optional.key)
-        silent = response is None or optional is not None or may_broadcast
+        # a request answered by the command whose code its field holds: the module's table of those replies
+        asks = method_name(request).upper() + "_ASKS" if request.asks_in and response is None else ""
+        silent = (response is None and not asks) or optional is not None or may_broadcast
         kind = "send"
         returns = "None"
         result_expr = ""
@@ -526,6 +528,16 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 doc.append(f"None when no reply is due ({why}).")
             for f in statuses:
                 doc.append(f"Raises DeviceError when the reply's {f.name} is not {f.status_ok}.")
+        elif asks:
+            # the reply is the response of the command whose code the argument holds: looked up before a byte is
+            # written (a code no command with a response has is refused)
+            kind, returns, result_expr = "message", "Message", "reply"
+            if silent:
+                returns = "Message | None"
+            doc.append("")
+            doc.append(f"Returns: the reply of the command whose code {request.asks_in} holds (see {asks}).")
+            if silent:
+                doc.append("None when no reply is due (broadcast gets no reply).")
         else:
             doc.append("")
             doc.append("The device does not answer.")
@@ -546,7 +558,18 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "returns": returns,
             "doc": doc,
             "request": request.class_name,
-            "response": response.class_name if response else "",
+            "response": (
+                f"asked_reply({asks}, {request.key!r}, {request.asks_in!r}, {request.asks_in})"
+                if asks
+                else response.class_name
+                if response
+                else ""
+            ),
+            "asks": (
+                (asks, [(c.code, c.response.class_name) for c in asked_commands(protocol) if c.response])
+                if asks
+                else None
+            ),
             "build": ", ".join(f"{f.name}={sequences.get(f.name, f.name)}" for f in fields),
             "kind": kind,
             "silent": silent,
@@ -622,6 +645,8 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
     )
     carriers = [m for m in methods if m["kind"] == "carry"]
     module_imports.update(name for m in carriers for request, _, reply in m["carried"] for name in (request, reply))
+    askers = [m for m in everything if m.get("asks")]
+    module_imports.update(name for m in askers for _, name in m["asks"][1])
     module_imports.discard("None")
     checks_status = any(m["statuses"] for m in everything)
     checks_echoes = any(m.get("echoed") for m in everything)
@@ -629,6 +654,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         *(["check_echoes"] if checks_echoes else []),
         *(["check_status"] if checks_status else []),
         *(["table_key"] if tables else []),
+        *(["asked_reply"] if askers else []),
     ]
     return dict(
         replies=replies,
@@ -645,6 +671,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         status=repr(tuple(e.name for e in status_elements(protocol))),
         methods=methods,
         carriers=carriers,
+        askers=[m["asks"] for m in askers],
         groups=list(groups.values()),
         registers=registers,
         status_flags=flags_literal,
@@ -664,6 +691,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             [
                 "BINDING",
                 *(m["carried_name"] for m in carriers),
+                *(m["asks"][0] for m in askers),
                 *(n for t in tables for n in (t["upper"], f"{t['upper']}_READ_ONLY")),
             ],
             key=import_order,
@@ -691,7 +719,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             ],
             key=import_order,
         ),
-        uses_message=any(m["kind"] == "carry" for m in everything),
+        uses_message=any(m["kind"] == "carry" for m in everything) or bool(askers),
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),
@@ -728,7 +756,8 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
     for request, response in request_response_pairs(protocol):
         refusing = refusals_of(request, replies)
         refusals = [m.class_name for m in refusing]
-        others = [m.class_name for m in (response, *refusing) if m and m.command != request.command]
+        asked = [c.response for c in asked_commands(protocol) if c.response] if request.asks_in else []
+        others = [m.class_name for m in (response, *asked, *refusing) if m and m.command != request.command]
         if others and "command" in protocol.matching:  # only matching by command needs telling
             answered.append((request.class_name, class_tuple(others)))
             classes += others

@@ -6,7 +6,7 @@ from dataclasses import replace
 from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
-from serialspec.backends.common.pairing import request_response_pairs
+from serialspec.backends.common.pairing import asked_commands, request_response_pairs
 from serialspec.backends.python.kinds import kind, zero_bits
 from serialspec.backends.python.registers import map_name, register_tables
 from serialspec.backends.python.render import one_line, render
@@ -280,6 +280,11 @@ def simulator_module(protocol: Protocol) -> str:
                 runs = getattr(behaviour, name)
                 if runs:
                     args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
+        if request.asks_in:  # the device acts as on the request of the command whose code the field holds
+            asked = [(c.code, c.request.class_name) for c in asked_commands(protocol) if c.request is not None]
+            imports.update(name for _, name in asked)
+            table = ", ".join(f"{code:#04x}: {name}" for code, name in asked)
+            args.append(f"asks=({request.asks_in!r}, {{{table}}})")
         derived = derived_values(request, response)
         refusals = refusals_of(request, replies_by_request(protocol.messages()))
         code = protocol.command(request.command).code
@@ -316,6 +321,8 @@ def simulator_module(protocol: Protocol) -> str:
         runs = {name for name, table in tables.items() if table[0] == "run"}
         filled = {*runs, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
         blanks = reply_blanks(protocol, response, filled) if response else {}
+        for refusal in refusals[:1]:  # a refusal's own fields (a NAK's text) get their blanks too
+            blanks = reply_blanks(protocol, refusal, filled) | blanks
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
         commands.append({"key": request.key, "args": args})

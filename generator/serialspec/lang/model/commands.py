@@ -46,6 +46,8 @@ class Message:
     optional_when: OptionalWhen | None = None  # a response sent only when a device parameter has a value
     after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
     answered_by: str = ""  # a request answered by another command's response (its key)
+    # a request answered by the response of the command whose code its field of this name holds (`command_in`)
+    asks_in: str = ""
     error_reply: bool = False  # the reply a device sends instead of any other (Modbus exceptions: code | flag)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
     struct_name: str = ""  # the construct struct of its content

@@ -360,6 +360,16 @@ class Commands(FieldResolver):
                 path = (*message_path(message), "answered_by")
                 if message.answered_by and message.answered_by not in responses:
                     self.error((*path, "command"), f"{message.answered_by!r} is not a command with a response")
+                if message.asks_in and not any(
+                    isinstance(c.code, int) and m.direction == Direction.RESPONSE
+                    for c in commands
+                    for m in c.messages()
+                ):
+                    self.error((*path, "command_in"), "no command has a response to ask for")
+                if message.asks_in and command.name in responses:
+                    self.error(
+                        path, f"{command.name} has a response of its own: leave out `answered_by` or the response"
+                    )
                 for index, name in enumerate(message.refused_by):
                     if name not in responses:
                         self.error((*path, "refused_by", index), f"{name!r} is not a command with a response")
@@ -518,6 +528,7 @@ class Commands(FieldResolver):
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
+            asks_in=self.asks_in(answered_by, fields, (*path, "answered_by")),
             refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
             request_code=self.request_code(value.get("request_code"), fields, direction, path),
             default_reply=bool(value.get("default", False)),
@@ -555,6 +566,24 @@ class Commands(FieldResolver):
             names = ", ".join(f.name for f in fields if isinstance(f, Scalar) and not f.hidden) or "none"
             self.error((*path, "request_code"), f"no integer field {value!r} in this response (it has: {names})")
         return str(value)
+
+    def asks_in(self, answered_by: dict[str, Any], fields: tuple[Field, ...], path: Path) -> str:
+        """`answered_by.command_in`: the request's integer field holding the code of the command that answers."""
+        name = answered_by.get("command_in")
+        if not answered_by:
+            return ""
+        if name is None:
+            if "command" not in answered_by:
+                self.error(
+                    path, "give the command that answers (`command`) or the field holding its code (`command_in`)"
+                )
+            return ""
+        if "command" in answered_by:
+            self.error((*path, "command_in"), "give `command` or `command_in`, not both")
+        if not any(isinstance(f, Scalar) and not (f.hidden or f.type.is_float) and f.name == name for f in fields):
+            names = ", ".join(f.name for f in fields if isinstance(f, Scalar) and not f.hidden) or "none"
+            self.error((*path, "command_in"), f"no integer field {name!r} in this request (it has: {names})")
+        return str(name)
 
     def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
         if value is None:

@@ -178,6 +178,10 @@ class TextPass(Pass):
         answered_by = raw.get("answered_by") or {}
         if answered_by and direction != Direction.REQUEST:
             self.error((*where, "answered_by"), "`answered_by` belongs to a request")
+        if "command_in" in answered_by:
+            self.error((*where, "answered_by", "command_in"), "`command_in` is not available in text frames yet")
+        elif answered_by and "command" not in answered_by:
+            self.error((*where, "answered_by"), "give the command that answers (`command`)")
         if "optional_when" in answered_by:
             self.error((*where, "answered_by", "optional_when"), "`optional_when` is not available in text frames yet")
         if answered_by and "response" in command:

@@ -122,6 +122,9 @@ class CommandSpec:
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
     carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
     refusal: type[Message] | None = None  # the reply of another command a refused request gets (`refused_by`)
+    # (request field, code -> request class): the request asks for the command whose code the field holds, and the
+    # device acts as on that command's request (`answered_by: {command_in: FIELD}`)
+    asks: tuple[str, dict[int, type[Message]]] | None = None
     # moves: where the state goes, a function of `get` (request fields, then memory and state); default: the target
     move_to: Callable[[Callable[[str], float]], float] | None = None
 
@@ -558,6 +561,9 @@ class Engine(FaultInjection):
         # `each`: every item of the group addresses its own device, with the item's fields over the request's.
         items = [{**fields, **item} for item in fields[command.each]] if command.each else [fields]
         replies = []
+        if command.asks:  # it asks for another command's reply: the devices act on that command's request
+            asked = self._asked(fields, *command.asks)
+            return self.handle(asked) if asked is not None else []
         if command.carries:  # each item holds another command's request: the devices act on that one
             for given in items:
                 carried = self._carried(given, *command.carries)
@@ -610,6 +616,19 @@ class Engine(FaultInjection):
             return decoder(content, 0, len(content))
         except (DecodeError, ValueError, struct.error):
             return None  # a block that does not parse as that request is ignored, like a bad frame
+
+    def _asked(self, given: dict[str, Any], code_field: str, requests: dict[int, type[Message]]) -> Message | None:
+        """The request a request for another command stands for: that command's, with the frame values (address,
+        ...) the asking request carries; None for a code the device does not know, or whose request needs content
+        (the device ignores it, as it would a frame it cannot act on)."""
+        request = requests.get(int(given[code_field]))
+        if request is None:
+            return None
+        names = field_keys(request)
+        try:
+            return request.from_fields({name: given[name] for name in names if name in given})  # type: ignore[attr-defined, no-any-return]
+        except (EncodeError, TypeError, ValueError, KeyError):
+            return None
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""

@@ -29,7 +29,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends.c import length_byte
 from serialspec.backends.c.build import files as c_files
-from serialspec.lang.model import Direction, Message
+from serialspec.lang.model import Direction, Message, TableValue, Text
 from serialspec.runtime.errors import DecodeError
 from strategies import message_fields
 
@@ -441,6 +441,58 @@ def test_random_messages_encode_and_decode_as_python_does(g: Generated, spec: Me
         check_decode_agrees(g, mutated, spec.direction)
 
     agree()
+
+
+TABLE_VALUES = by_protocol(
+    [(g, m) for g in C_SPECS for m in g.protocol.messages() if any(isinstance(f, TableValue) for f in m.fields)]
+)
+
+
+@pytest.mark.parametrize(("g", "spec"), TABLE_VALUES)
+def test_every_key_of_a_table_value_encodes_and_decodes_as_python_does(g: Generated, spec: Message) -> None:
+    """A value typed by a table (FashionStar's data by data_id): each key's type at its least and greatest value
+    through the Python codec and the C (a few random messages reach only a few of the keys' cases)."""
+
+    @settings(max_examples=1, deadline=None, derandomize=True)
+    @given(message_fields(g.protocol, spec))
+    def each_key(fields: dict[str, Any]) -> None:
+        for f in spec.fields:
+            if isinstance(f, TableValue):
+                for entry in (e for e in f.table.entries if not e.reserved):
+                    for value in (entry.minimum, entry.maximum):
+                        number = value if entry.type.is_float else int(value)
+                        agrees_with_python(
+                            driver(g.protocol.name), g, spec, {**fields, f.key: entry.key, f.name: number}
+                        )
+
+    each_key()
+
+
+WIDE = "é€😀"  # UTF-8 of 2, 3 and 4 bytes
+
+
+def wide_text(f: Any) -> bool:
+    """A text the wide characters fit: NUL-terminated, the rest of the content, or padded to room for them."""
+    return isinstance(f, Text) and (
+        f.size in (None, "rest") or (isinstance(f.size, int) and f.pad is not None and f.size >= 9)
+    )
+
+
+WIDE_TEXTS = by_protocol([(g, m) for g in C_SPECS for m in g.protocol.messages() if any(map(wide_text, m.fields))])
+
+
+@pytest.mark.parametrize(("g", "spec"), WIDE_TEXTS)
+def test_text_of_characters_past_ascii_encodes_and_decodes_as_python_does(g: Generated, spec: Message) -> None:
+    """Texts of 2-, 3- and 4-byte UTF-8 characters through the Python codec and the C (random texts are ASCII:
+    the C's UTF-8 check of each longer form ran nowhere else)."""
+
+    @settings(max_examples=1, deadline=None, derandomize=True)
+    @given(message_fields(g.protocol, spec))
+    def wide(fields: dict[str, Any]) -> None:
+        texts = {f.name: WIDE for f in spec.fields if wide_text(f)}
+        agrees_with_python(driver(g.protocol.name), g, spec, {**fields, **texts})
+
+    wide()
 
 
 def mutate(frame: bytes, data: st.DataObject) -> bytes:

@@ -190,7 +190,7 @@ static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
+#if FASHIONSTAR_UART__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int fashionstar_uart__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -303,6 +303,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     int last = fashionstar_uart__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if FASHIONSTAR_UART__STUFFED
     if (FASHIONSTAR_UART__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -338,10 +339,12 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
+#if FASHIONSTAR_UART__STUFFED
         if (FASHIONSTAR_UART__T(L) && k == L->t_first) {
             size_t made;
             if (!fashionstar_uart__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -360,6 +363,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == FASHIONSTAR_UART__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return FASHIONSTAR_UART_E_BUFFER;
@@ -382,6 +386,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];

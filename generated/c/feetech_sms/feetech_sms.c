@@ -190,7 +190,7 @@ static int feetech_sms__inner_last(const feetech_sms__layout_t *L)
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
+#if FEETECH_SMS__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int feetech_sms__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -303,6 +303,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     int last = feetech_sms__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if FEETECH_SMS__STUFFED
     if (FEETECH_SMS__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -338,10 +339,12 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
+#if FEETECH_SMS__STUFFED
         if (FEETECH_SMS__T(L) && k == L->t_first) {
             size_t made;
             if (!feetech_sms__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -360,6 +363,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == FEETECH_SMS__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return FEETECH_SMS_E_BUFFER;
@@ -382,6 +386,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];

@@ -240,7 +240,7 @@ static int mavlink_common__inner_last(const mavlink_common__layout_t *L)
 }
 #endif
 
-#if MAVLINK_COMMON_ENABLE_ENCODE || MAVLINK_COMMON__STUFFED
+#if MAVLINK_COMMON__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int mavlink_common__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -353,6 +353,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
     int last = mavlink_common__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MAVLINK_COMMON__STUFFED
     if (MAVLINK_COMMON__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -388,10 +389,12 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const mavlink_common__element_t *e = &L->e[k];
+#if MAVLINK_COMMON__STUFFED
         if (MAVLINK_COMMON__T(L) && k == L->t_first) {
             size_t made;
             if (!mavlink_common__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -410,6 +413,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MAVLINK_COMMON__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MAVLINK_COMMON_E_BUFFER;
@@ -432,6 +436,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const mavlink_common__element_t *e = &L->e[k];

@@ -190,7 +190,7 @@ static int modbus_ascii__inner_last(const modbus_ascii__layout_t *L)
 }
 #endif
 
-#if MODBUS_ASCII_ENABLE_ENCODE || MODBUS_ASCII__STUFFED
+#if MODBUS_ASCII__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The value of a hex digit of either case; 16 for a byte that is none. */
 static uint8_t modbus_ascii__hex_ascii_value(uint8_t c)
 {
@@ -365,6 +365,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
     int last = modbus_ascii__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MODBUS_ASCII__STUFFED
     if (MODBUS_ASCII__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -400,10 +401,12 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_ascii__element_t *e = &L->e[k];
+#if MODBUS_ASCII__STUFFED
         if (MODBUS_ASCII__T(L) && k == L->t_first) {
             size_t made;
             if (!modbus_ascii__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -422,6 +425,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MODBUS_ASCII__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MODBUS_ASCII_E_BUFFER;
@@ -444,6 +448,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_ascii__element_t *e = &L->e[k];

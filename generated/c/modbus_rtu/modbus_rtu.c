@@ -194,7 +194,7 @@ static int modbus_rtu__inner_last(const modbus_rtu__layout_t *L)
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
+#if MODBUS_RTU__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int modbus_rtu__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +307,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     int last = modbus_rtu__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MODBUS_RTU__STUFFED
     if (MODBUS_RTU__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +343,12 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
+#if MODBUS_RTU__STUFFED
         if (MODBUS_RTU__T(L) && k == L->t_first) {
             size_t made;
             if (!modbus_rtu__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +367,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MODBUS_RTU__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MODBUS_RTU_E_BUFFER;
@@ -386,6 +390,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];

@@ -194,7 +194,7 @@ static int vesc__inner_last(const vesc__layout_t *L)
 }
 #endif
 
-#if VESC_ENABLE_ENCODE || VESC__STUFFED
+#if VESC__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int vesc__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +307,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     int last = vesc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if VESC__STUFFED
     if (VESC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +343,12 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
+#if VESC__STUFFED
         if (VESC__T(L) && k == L->t_first) {
             size_t made;
             if (!vesc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +367,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == VESC__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return VESC_E_BUFFER;
@@ -386,6 +390,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];

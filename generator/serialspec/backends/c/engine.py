@@ -136,7 +136,7 @@ static int pfx__inner_last(const pfx__layout_t *L)
 }
 #endif
 
-#if PFX_ENABLE_ENCODE || PFX__STUFFED
+#if PFX__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* ---- transforms ---- */
 
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
@@ -223,6 +223,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if PFX__STUFFED
     if (PFX__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -258,10 +259,12 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
+#if PFX__STUFFED
         if (PFX__T(L) && k == L->t_first) {
             size_t made;
             if (!pfx__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -280,6 +283,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == PFX__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return PFX_E_BUFFER;
@@ -302,6 +306,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];

@@ -29,6 +29,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends.c import length_byte
 from serialspec.backends.c.build import files as c_files
+from serialspec.backends.c.emit import messages as c_messages
+from serialspec.backends.c.emit import msg_id
 from serialspec.lang.model import Direction, Message, TableValue, Text
 from serialspec.runtime.errors import DecodeError
 from strategies import message_fields
@@ -937,6 +939,18 @@ def test_feature_switches_leave_out_encode_decode_or_parser_without_a_warning(g:
         assert run.returncode == 0 and not run.stderr, run.stderr.decode()
 
 
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_api_refuses_null_pointers_and_values_outside_its_enums(g: Generated) -> None:
+    """decode and encode given NULL, a direction or a kind no enum value names: E_ARG, nothing written; the names of
+    no kind and no result: ""; to_json(NULL): null; a parser made for no direction finds nothing."""
+    (answer,) = driver(g.protocol.name).ask("args request")
+    words = answer.split(" ")
+    assert words[:9] == ["args", *["E_ARG"] * 6, "0", "[]"], answer
+    assert words[9:12] == ["[]", "[]", "[]"], answer
+    assert words[12] == "null" and words[13].startswith("{"), answer
+    assert words[-3:] == ["1", "0", "0"], answer  # the byte taken, no message, no event
+
+
 ROLES = ("HOST", "DEVICE")
 
 
@@ -966,9 +980,28 @@ def test_a_build_for_one_role_keeps_its_side_and_refuses_the_other(g: Generated,
         run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
         assert run.returncode == 0 and run.stdout.endswith(" 0 failed\n"), run.stdout + run.stderr
     full = driver(name)
-    one = Driver(name, GENERATED_C / name, tmp_path, defines=(role_define,))
+    each = tmp_path / "each.h"  # every message's own encoder, called with a zeroed message
+    calls = [
+        f'    {{ static {name}_{msg_id(m)}_t m; printf(" {msg_id(m)}=%s", '
+        f"{name}_result_name({name}_encode_{msg_id(m)}(&m, b, sizeof(b), &n))); }}"
+        for m in c_messages(g.protocol)
+    ]
+    each.write_text(
+        "static void each_encoder(void)\n{\n    static uint8_t b[1 << 16];\n    size_t n;\n"
+        '    printf("each");\n' + "\n".join(calls) + '\n    printf("\\n");\n}\n'
+    )
+    one = Driver(name, GENERATED_C / name, tmp_path, defines=(role_define, f'-DDRIVER_EACH="{each}"'))
     reads = Direction.RESPONSE if role == "HOST" else Direction.REQUEST
     try:
+        # every kind, zeroed: the side the role sends encodes as in the full build, the other is refused, through
+        # encode and through each message's own encoder
+        (every,) = full.ask("kinds request")
+        (kept,) = one.ask("kinds request")
+        (own,) = one.ask("each request")
+        for both, this, alone in zip(every.split()[1:], kept.split()[1:], own.split()[1:], strict=True):
+            refused = both.split("=")[0].endswith(f"_{reads.value}")
+            assert this == alone == (both.split("=")[0] + "=E_ARG" if refused else both), (both, this, alone)
+        assert one.ask("args request") == full.ask("args request")
         for example in g.protocol.examples:
             d, frame = example.direction.value, example.frame.hex()
             kind = kind_of(g, example_class(g, example))

@@ -59,10 +59,8 @@ uint8_t crsf_crc_8_dvb_s2(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t crsf__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(crsf_crc_8_dvb_s2(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +79,7 @@ static uint32_t crsf__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!CRSF__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if CRSF_ENABLE_DECODE || CRSF__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int crsf__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +91,7 @@ static int crsf__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define CRSF__T(L) (CRSF__STUFFED && (L)->has_t)
@@ -653,12 +653,9 @@ static const crsf__layout_t *const *crsf__layouts(crsf_direction_t dir, uint8_t 
     case CRSF_REQUEST:
         *count = 1u;
         return crsf__layouts_request;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         *count = 1u;
         return crsf__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -821,7 +818,7 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         default:
             return CRSF__NONE;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L:
             size = 15L;
@@ -841,8 +838,6 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         default:
             return CRSF__NONE;
         }
-    default:
-        return CRSF__NONE;
     }
 }
 #endif
@@ -863,7 +858,7 @@ static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *hi
         case 40L: *low = 2u; *high = 2u; *bounded = 1; return 1;
         default: return 0;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L: *low = 15u; *high = 15u; *bounded = 1; return 1;
         case 8L: *low = 8u; *high = 8u; *bounded = 1; return 1;
@@ -874,8 +869,6 @@ static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *hi
         case 41L: *low = 17u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -925,35 +918,15 @@ static long crsf__probe_at(crsf_direction_t dir, uint8_t k, const uint8_t *b, si
     switch (dir) {
     case CRSF_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if CRSF__STUFFED
-    {
-        uint8_t count;
-        const crsf__layout_t *const *layouts = crsf__layouts(dir, &count);
-        return k < count ? crsf__probe(layouts[k], dir, b, avail) : CRSF__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return CRSF__NONE;
-#endif
 }
 #endif
 
@@ -968,40 +941,25 @@ static uint8_t crsf__count(crsf_direction_t dir)
     switch (dir) {
     case CRSF_REQUEST:
         return 1u;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *crsf__header(crsf_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case CRSF_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return crsf__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case CRSF_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return crsf__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {crsf__h_request_0};
+    static const uint8_t requests_len[] = {1u};
+    static const uint8_t *const responses[] = {crsf__h_response_0};
+    static const uint8_t responses_len[] = {1u};
+    if (dir == CRSF_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1010,10 +968,8 @@ static int crsf__has_command(crsf_direction_t dir, uint8_t k)
     switch (dir) {
     case CRSF_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1062,35 +1018,15 @@ static int crsf__unwrap_at(crsf_direction_t dir, uint8_t k, const uint8_t *frame
     switch (dir) {
     case CRSF_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if CRSF__STUFFED
-    {
-        uint8_t count;
-        const crsf__layout_t *const *layouts = crsf__layouts(dir, &count);
-        if (k < count) {
-            return crsf__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return CRSF_E_ARG;
-#else
-    return CRSF_E_ARG;
-#endif
 }
 
 
@@ -1551,7 +1487,7 @@ static int crsf__decode_content(crsf_direction_t dir, long code, crsf_kind_t exp
         }
         default: return CRSF_E_UNKNOWN;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L: {
             out->kind = CRSF_GPS_RESPONSE; r = crsf__dec_gps_response(c, n, &out->u.gps_response);  return r;
@@ -1576,8 +1512,6 @@ static int crsf__decode_content(crsf_direction_t dir, long code, crsf_kind_t exp
         }
         default: return CRSF_E_UNKNOWN;
         }
-    default:
-        return CRSF_E_ARG;
     }
 }
 
@@ -1597,9 +1531,6 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
         return CRSF_E_ARG;
     }
     count = crsf__count(dir);
-    if (count == 0u) {
-        return CRSF_E_ARG;
-    }
     k = 0u;
     if (!CRSF__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

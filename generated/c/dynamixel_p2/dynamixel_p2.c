@@ -59,10 +59,8 @@ uint16_t dynamixel_p2_crc_16_umts(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(dynamixel_p2_crc_16_umts(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +79,7 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!DYNAMIXEL_P2__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if DYNAMIXEL_P2_ENABLE_DECODE || DYNAMIXEL_P2__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +91,7 @@ static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define DYNAMIXEL_P2__T(L) (DYNAMIXEL_P2__STUFFED && (L)->has_t)
@@ -673,12 +673,9 @@ static const dynamixel_p2__layout_t *const *dynamixel_p2__layouts(dynamixel_p2_d
     case DYNAMIXEL_P2_REQUEST:
         *count = 1u;
         return dynamixel_p2__layouts_request;
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         *count = 1u;
         return dynamixel_p2__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -731,14 +728,12 @@ static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, 
         default:
             return DYNAMIXEL_P2__NONE;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
 
         default:
             return DYNAMIXEL_P2__NONE;
         }
-    default:
-        return DYNAMIXEL_P2__NONE;
     }
 }
 #endif
@@ -765,13 +760,11 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
         case 147L: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
         case DYNAMIXEL_P2__NO_CODE: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -782,7 +775,6 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
 static long dynamixel_p2__probe_at(dynamixel_p2_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
 {
     switch (dir) {
-
     default:
         break;
     }
@@ -812,40 +804,25 @@ static uint8_t dynamixel_p2__count(dynamixel_p2_direction_t dir)
     switch (dir) {
     case DYNAMIXEL_P2_REQUEST:
         return 1u;
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *dynamixel_p2__header(dynamixel_p2_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case DYNAMIXEL_P2_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 3u;
-            return dynamixel_p2__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case DYNAMIXEL_P2_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 3u;
-            return dynamixel_p2__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {dynamixel_p2__h_request_0};
+    static const uint8_t requests_len[] = {3u};
+    static const uint8_t *const responses[] = {dynamixel_p2__h_response_0};
+    static const uint8_t responses_len[] = {3u};
+    if (dir == DYNAMIXEL_P2_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -854,10 +831,8 @@ static int dynamixel_p2__has_command(dynamixel_p2_direction_t dir, uint8_t k)
     switch (dir) {
     case DYNAMIXEL_P2_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         return ((0UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -869,7 +844,6 @@ static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, cons
     (void)k;
     (void)plain;
     switch (dir) {
-
     default:
         break;
     }
@@ -1279,7 +1253,7 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
         }
         default: return DYNAMIXEL_P2_E_UNKNOWN;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
         case DYNAMIXEL_P2__NO_CODE: {
             if (expect == DYNAMIXEL_P2_PING_RESPONSE) {
@@ -1289,8 +1263,6 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
         }
         default: return DYNAMIXEL_P2_E_UNKNOWN;
         }
-    default:
-        return DYNAMIXEL_P2_E_ARG;
     }
 }
 
@@ -1310,9 +1282,6 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
         return DYNAMIXEL_P2_E_ARG;
     }
     count = dynamixel_p2__count(dir);
-    if (count == 0u) {
-        return DYNAMIXEL_P2_E_ARG;
-    }
     k = 0u;
     if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

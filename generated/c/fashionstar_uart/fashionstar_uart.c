@@ -55,10 +55,8 @@ uint8_t fashionstar_uart_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return ((uint32_t)(fashionstar_uart_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +75,7 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!FASHIONSTAR_UART__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if FASHIONSTAR_UART_ENABLE_DECODE || FASHIONSTAR_UART__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +87,7 @@ static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FASHIONSTAR_UART__T(L) (FASHIONSTAR_UART__STUFFED && (L)->has_t)
@@ -649,12 +649,9 @@ static const fashionstar_uart__layout_t *const *fashionstar_uart__layouts(fashio
     case FASHIONSTAR_UART_REQUEST:
         *count = 1u;
         return fashionstar_uart__layouts_request;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         *count = 1u;
         return fashionstar_uart__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -774,7 +771,7 @@ static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, lon
         default:
             return FASHIONSTAR_UART__NONE;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -827,8 +824,6 @@ static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, lon
         default:
             return FASHIONSTAR_UART__NONE;
         }
-    default:
-        return FASHIONSTAR_UART__NONE;
     }
 }
 #endif
@@ -865,7 +860,7 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
         case 25L: *low = 3u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 1u; *bounded = 1; return 1;
         case 2L: *low = 2u; *high = 2u; *bounded = 1; return 1;
@@ -886,8 +881,6 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
         case 22L: *low = 16u; *high = 16u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -904,40 +897,25 @@ static uint8_t fashionstar_uart__count(fashionstar_uart_direction_t dir)
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         return 1u;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *fashionstar_uart__header(fashionstar_uart_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case FASHIONSTAR_UART_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return fashionstar_uart__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case FASHIONSTAR_UART_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return fashionstar_uart__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {fashionstar_uart__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {fashionstar_uart__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == FASHIONSTAR_UART_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -946,10 +924,8 @@ static int fashionstar_uart__has_command(fashionstar_uart_direction_t dir, uint8
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1000,35 +976,15 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FASHIONSTAR_UART__STUFFED
-    {
-        uint8_t count;
-        const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
-        if (k < count) {
-            return fashionstar_uart__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return FASHIONSTAR_UART_E_ARG;
-#else
-    return FASHIONSTAR_UART_E_ARG;
-#endif
 }
 
 
@@ -2339,7 +2295,7 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
         }
         default: return FASHIONSTAR_UART_E_UNKNOWN;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L: {
             out->kind = FASHIONSTAR_UART_PING_RESPONSE; r = fashionstar_uart__dec_ping_response(c, n, &out->u.ping_response);  return r;
@@ -2394,8 +2350,6 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
         }
         default: return FASHIONSTAR_UART_E_UNKNOWN;
         }
-    default:
-        return FASHIONSTAR_UART_E_ARG;
     }
 }
 
@@ -2415,9 +2369,6 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
         return FASHIONSTAR_UART_E_ARG;
     }
     count = fashionstar_uart__count(dir);
-    if (count == 0u) {
-        return FASHIONSTAR_UART_E_ARG;
-    }
     k = 0u;
     if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

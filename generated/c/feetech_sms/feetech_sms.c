@@ -55,10 +55,8 @@ uint8_t feetech_sms_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (~(uint32_t)(feetech_sms_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +75,7 @@ static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!FEETECH_SMS__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if FEETECH_SMS_ENABLE_DECODE || FEETECH_SMS__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +87,7 @@ static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FEETECH_SMS__T(L) (FEETECH_SMS__STUFFED && (L)->has_t)
@@ -651,12 +651,9 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
     case FEETECH_SMS_REQUEST:
         *count = 1u;
         return feetech_sms__layouts_request;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         *count = 1u;
         return feetech_sms__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -703,14 +700,12 @@ static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, co
         default:
             return FEETECH_SMS__NONE;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
 
         default:
             return FEETECH_SMS__NONE;
         }
-    default:
-        return FEETECH_SMS__NONE;
     }
 }
 #endif
@@ -732,13 +727,11 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
         case 131L: *low = 2u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
         case FEETECH_SMS__NO_CODE: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -755,40 +748,25 @@ static uint8_t feetech_sms__count(feetech_sms_direction_t dir)
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         return 1u;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *feetech_sms__header(feetech_sms_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case FEETECH_SMS_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return feetech_sms__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case FEETECH_SMS_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return feetech_sms__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {feetech_sms__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {feetech_sms__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == FEETECH_SMS_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -797,10 +775,8 @@ static int feetech_sms__has_command(feetech_sms_direction_t dir, uint8_t k)
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         return ((0UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -855,35 +831,15 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FEETECH_SMS__STUFFED
-    {
-        uint8_t count;
-        const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
-        if (k < count) {
-            return feetech_sms__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return FEETECH_SMS_E_ARG;
-#else
-    return FEETECH_SMS_E_ARG;
-#endif
 }
 
 
@@ -1110,15 +1066,13 @@ static int feetech_sms__decode_content(feetech_sms_direction_t dir, long code, f
         }
         default: return FEETECH_SMS_E_UNKNOWN;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
         case FEETECH_SMS__NO_CODE: {
             out->kind = FEETECH_SMS_REPLY_RESPONSE; r = feetech_sms__dec_reply_response(c, n, &out->u.reply_response); out->u.reply_response.id = (uint8_t)values[0]; out->u.reply_response.error = (uint8_t)values[1]; return r;
         }
         default: return FEETECH_SMS_E_UNKNOWN;
         }
-    default:
-        return FEETECH_SMS_E_ARG;
     }
 }
 
@@ -1138,9 +1092,6 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
         return FEETECH_SMS_E_ARG;
     }
     count = feetech_sms__count(dir);
-    if (count == 0u) {
-        return FEETECH_SMS_E_ARG;
-    }
     k = 0u;
     if (!FEETECH_SMS__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

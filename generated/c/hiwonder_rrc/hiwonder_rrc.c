@@ -59,10 +59,8 @@ uint8_t hiwonder_rrc_crc_8_maxim(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(hiwonder_rrc_crc_8_maxim(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +79,7 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!HIWONDER_RRC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if HIWONDER_RRC_ENABLE_DECODE || HIWONDER_RRC__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +91,7 @@ static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define HIWONDER_RRC__T(L) (HIWONDER_RRC__STUFFED && (L)->has_t)
@@ -653,12 +653,9 @@ static const hiwonder_rrc__layout_t *const *hiwonder_rrc__layouts(hiwonder_rrc_d
     case HIWONDER_RRC_REQUEST:
         *count = 1u;
         return hiwonder_rrc__layouts_request;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         *count = 1u;
         return hiwonder_rrc__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -749,7 +746,7 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
         default:
             return HIWONDER_RRC__NONE;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 6L:
             size = 2L;
@@ -769,8 +766,6 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
         default:
             return HIWONDER_RRC__NONE;
         }
-    default:
-        return HIWONDER_RRC__NONE;
     }
 }
 #endif
@@ -791,7 +786,7 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
         case 11L: *low = 2u; *high = 1022u; *bounded = 1; return 1;
         default: return 0;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 4L: *low = 3u; *high = 4u; *bounded = 1; return 1;
         case 5L: *low = 4u; *high = 7u; *bounded = 1; return 1;
@@ -802,8 +797,6 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
         case 0L: *low = 3u; *high = 3u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -820,40 +813,25 @@ static uint8_t hiwonder_rrc__count(hiwonder_rrc_direction_t dir)
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         return 1u;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *hiwonder_rrc__header(hiwonder_rrc_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case HIWONDER_RRC_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return hiwonder_rrc__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case HIWONDER_RRC_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return hiwonder_rrc__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {hiwonder_rrc__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {hiwonder_rrc__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == HIWONDER_RRC_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -862,10 +840,8 @@ static int hiwonder_rrc__has_command(hiwonder_rrc_direction_t dir, uint8_t k)
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -916,35 +892,15 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if HIWONDER_RRC__STUFFED
-    {
-        uint8_t count;
-        const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
-        if (k < count) {
-            return hiwonder_rrc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return HIWONDER_RRC_E_ARG;
-#else
-    return HIWONDER_RRC_E_ARG;
-#endif
 }
 
 
@@ -2267,7 +2223,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
         }
         default: return HIWONDER_RRC_E_UNKNOWN;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 4L: {
             if (n <= 1u) { return HIWONDER_RRC_E_LENGTH; }
@@ -2313,8 +2269,6 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
         }
         default: return HIWONDER_RRC_E_UNKNOWN;
         }
-    default:
-        return HIWONDER_RRC_E_ARG;
     }
 }
 
@@ -2334,9 +2288,6 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
         return HIWONDER_RRC_E_ARG;
     }
     count = hiwonder_rrc__count(dir);
-    if (count == 0u) {
-        return HIWONDER_RRC_E_ARG;
-    }
     k = 0u;
     if (!HIWONDER_RRC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -105,10 +105,8 @@ uint16_t mavlink_common_crc_16_mcrf4xx_seeded(uint16_t acc, const uint8_t *data,
 static uint32_t mavlink_common__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(mavlink_common_crc_16_mcrf4xx_seeded(0xffffu, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -127,6 +125,7 @@ static uint32_t mavlink_common__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MAVLINK_COMMON__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MAVLINK_COMMON_ENABLE_DECODE || MAVLINK_COMMON__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int mavlink_common__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -138,6 +137,7 @@ static int mavlink_common__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MAVLINK_COMMON__T(L) (MAVLINK_COMMON__STUFFED && (L)->has_t)
@@ -759,12 +759,9 @@ static const mavlink_common__layout_t *const *mavlink_common__layouts(mavlink_co
     case MAVLINK_COMMON_REQUEST:
         *count = 2u;
         return mavlink_common__layouts_request;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         *count = 2u;
         return mavlink_common__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -888,7 +885,7 @@ static long mavlink_common__content_size(mavlink_common_direction_t dir, long co
         default:
             return MAVLINK_COMMON__NONE;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L:
             size = 9L;
@@ -911,8 +908,6 @@ static long mavlink_common__content_size(mavlink_common_direction_t dir, long co
         default:
             return MAVLINK_COMMON__NONE;
         }
-    default:
-        return MAVLINK_COMMON__NONE;
     }
 }
 #endif
@@ -929,7 +924,7 @@ static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, siz
         case 76L: *low = 1u; *high = 33u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L: *low = 1u; *high = 9u; *bounded = 1; return 1;
         case 1L: *low = 1u; *high = 43u; *bounded = 1; return 1;
@@ -939,8 +934,6 @@ static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, siz
         case 77L: *low = 1u; *high = 10u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -1070,37 +1063,17 @@ static long mavlink_common__probe_at(mavlink_common_direction_t dir, uint8_t k, 
         switch (k) {
         case 0u:
             return mavlink_common__probe_request_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__probe_request_1(b, avail);
-        default:
-            break;
         }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (k) {
         case 0u:
             return mavlink_common__probe_response_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__probe_response_1(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if MAVLINK_COMMON__STUFFED
-    {
-        uint8_t count;
-        const mavlink_common__layout_t *const *layouts = mavlink_common__layouts(dir, &count);
-        return k < count ? mavlink_common__probe(layouts[k], dir, b, avail) : MAVLINK_COMMON__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return MAVLINK_COMMON__NONE;
-#endif
 }
 #endif
 
@@ -1117,46 +1090,25 @@ static uint8_t mavlink_common__count(mavlink_common_direction_t dir)
     switch (dir) {
     case MAVLINK_COMMON_REQUEST:
         return 2u;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         return 2u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *mavlink_common__header(mavlink_common_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MAVLINK_COMMON_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return mavlink_common__h_request_0;
-        case 1u:
-            *len = 1u;
-            return mavlink_common__h_request_1;
-        default:
-            break;
-        }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return mavlink_common__h_response_0;
-        case 1u:
-            *len = 1u;
-            return mavlink_common__h_response_1;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {mavlink_common__h_request_0, mavlink_common__h_request_1};
+    static const uint8_t requests_len[] = {1u, 1u};
+    static const uint8_t *const responses[] = {mavlink_common__h_response_0, mavlink_common__h_response_1};
+    static const uint8_t responses_len[] = {1u, 1u};
+    if (dir == MAVLINK_COMMON_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1165,10 +1117,8 @@ static int mavlink_common__has_command(mavlink_common_direction_t dir, uint8_t k
     switch (dir) {
     case MAVLINK_COMMON_REQUEST:
         return ((3UL >> k) & 1u) != 0u;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         return ((3UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1283,37 +1233,17 @@ static int mavlink_common__unwrap_at(mavlink_common_direction_t dir, uint8_t k, 
         switch (k) {
         case 0u:
             return mavlink_common__unwrap_request_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__unwrap_request_1(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (k) {
         case 0u:
             return mavlink_common__unwrap_response_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__unwrap_response_1(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if MAVLINK_COMMON__STUFFED
-    {
-        uint8_t count;
-        const mavlink_common__layout_t *const *layouts = mavlink_common__layouts(dir, &count);
-        if (k < count) {
-            return mavlink_common__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return MAVLINK_COMMON_E_ARG;
-#else
-    return MAVLINK_COMMON_E_ARG;
-#endif
 }
 
 
@@ -1883,7 +1813,7 @@ static int mavlink_common__decode_content(mavlink_common_direction_t dir, long c
         }
         default: return MAVLINK_COMMON_E_UNKNOWN;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L: {
             out->kind = MAVLINK_COMMON_HEARTBEAT_RESPONSE; r = mavlink_common__dec_heartbeat_response(c, n, &out->u.heartbeat_response); out->u.heartbeat_response.seq = (uint8_t)values[0]; out->u.heartbeat_response.sysid = (uint8_t)values[1]; out->u.heartbeat_response.compid = (uint8_t)values[2]; mavlink_common__extra(&out->u.heartbeat_response.has_signature, out->u.heartbeat_response.signature, extras[0], 13u); return r;
@@ -1905,8 +1835,6 @@ static int mavlink_common__decode_content(mavlink_common_direction_t dir, long c
         }
         default: return MAVLINK_COMMON_E_UNKNOWN;
         }
-    default:
-        return MAVLINK_COMMON_E_ARG;
     }
 }
 
@@ -1927,9 +1855,6 @@ int mavlink_common_decode_expect(const uint8_t *frame, size_t len, mavlink_commo
         return MAVLINK_COMMON_E_ARG;
     }
     count = mavlink_common__count(dir);
-    if (count == 0u) {
-        return MAVLINK_COMMON_E_ARG;
-    }
     k = 0u;
     if (!MAVLINK_COMMON__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -55,10 +55,8 @@ uint8_t modbus_ascii_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t modbus_ascii__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (-(uint32_t)(modbus_ascii_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +75,7 @@ static uint32_t modbus_ascii__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MODBUS_ASCII__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MODBUS_ASCII_ENABLE_DECODE || MODBUS_ASCII__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_ascii__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +87,7 @@ static int modbus_ascii__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MODBUS_ASCII__T(L) (MODBUS_ASCII__STUFFED && (L)->has_t)
@@ -717,12 +717,9 @@ static const modbus_ascii__layout_t *const *modbus_ascii__layouts(modbus_ascii_d
     case MODBUS_ASCII_REQUEST:
         *count = 1u;
         return modbus_ascii__layouts_request;
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         *count = 1u;
         return modbus_ascii__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -793,7 +790,7 @@ static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, 
         default:
             return MODBUS_ASCII__NONE;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -841,8 +838,6 @@ static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, 
         default:
             return MODBUS_ASCII__NONE;
         }
-    default:
-        return MODBUS_ASCII__NONE;
     }
 }
 #endif
@@ -866,7 +861,7 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
         case 23L: *low = 9u; *high = 251u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 256u; *bounded = 1; return 1;
         case 2L: *low = 1u; *high = 256u; *bounded = 1; return 1;
@@ -881,8 +876,6 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
         case MODBUS_ASCII__ERROR_CODE: *low = 1u; *high = 1u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -893,7 +886,6 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
 static long modbus_ascii__probe_at(modbus_ascii_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
 {
     switch (dir) {
-
     default:
         break;
     }
@@ -923,40 +915,25 @@ static uint8_t modbus_ascii__count(modbus_ascii_direction_t dir)
     switch (dir) {
     case MODBUS_ASCII_REQUEST:
         return 1u;
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *modbus_ascii__header(modbus_ascii_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MODBUS_ASCII_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return modbus_ascii__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case MODBUS_ASCII_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return modbus_ascii__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {modbus_ascii__h_request_0};
+    static const uint8_t requests_len[] = {1u};
+    static const uint8_t *const responses[] = {modbus_ascii__h_response_0};
+    static const uint8_t responses_len[] = {1u};
+    if (dir == MODBUS_ASCII_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -965,10 +942,8 @@ static int modbus_ascii__has_command(modbus_ascii_direction_t dir, uint8_t k)
     switch (dir) {
     case MODBUS_ASCII_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -980,7 +955,6 @@ static int modbus_ascii__unwrap_at(modbus_ascii_direction_t dir, uint8_t k, cons
     (void)k;
     (void)plain;
     switch (dir) {
-
     default:
         break;
     }
@@ -1559,7 +1533,7 @@ static int modbus_ascii__decode_content(modbus_ascii_direction_t dir, long code,
         }
         default: return MODBUS_ASCII_E_UNKNOWN;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         if (code >= 0 && ((unsigned long)code & 128UL) != 0u) {
             out->u.exception_response.function = (uint8_t)((unsigned long)code & 127UL);
             out->kind = MODBUS_ASCII_EXCEPTION_RESPONSE; r = modbus_ascii__dec_exception_response(c, n, &out->u.exception_response); out->u.exception_response.unit = (uint8_t)values[0]; return r;
@@ -1597,8 +1571,6 @@ static int modbus_ascii__decode_content(modbus_ascii_direction_t dir, long code,
         }
         default: return MODBUS_ASCII_E_UNKNOWN;
         }
-    default:
-        return MODBUS_ASCII_E_ARG;
     }
 }
 
@@ -1618,9 +1590,6 @@ int modbus_ascii_decode_expect(const uint8_t *frame, size_t len, modbus_ascii_di
         return MODBUS_ASCII_E_ARG;
     }
     count = modbus_ascii__count(dir);
-    if (count == 0u) {
-        return MODBUS_ASCII_E_ARG;
-    }
     k = 0u;
     if (!MODBUS_ASCII__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -59,10 +59,8 @@ uint16_t modbus_rtu_crc_16_modbus(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(modbus_rtu_crc_16_modbus(0xffffu, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +79,7 @@ static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MODBUS_RTU__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MODBUS_RTU_ENABLE_DECODE || MODBUS_RTU__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +91,7 @@ static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MODBUS_RTU__T(L) (MODBUS_RTU__STUFFED && (L)->has_t)
@@ -649,12 +649,9 @@ static const modbus_rtu__layout_t *const *modbus_rtu__layouts(modbus_rtu_directi
     case MODBUS_RTU_REQUEST:
         *count = 1u;
         return modbus_rtu__layouts_request;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         *count = 1u;
         return modbus_rtu__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -725,7 +722,7 @@ static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, cons
         default:
             return MODBUS_RTU__NONE;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -773,8 +770,6 @@ static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, cons
         default:
             return MODBUS_RTU__NONE;
         }
-    default:
-        return MODBUS_RTU__NONE;
     }
 }
 #endif
@@ -798,7 +793,7 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
         case 23L: *low = 9u; *high = 251u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 256u; *bounded = 1; return 1;
         case 2L: *low = 1u; *high = 256u; *bounded = 1; return 1;
@@ -813,8 +808,6 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
         case MODBUS_RTU__ERROR_CODE: *low = 1u; *high = 1u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -862,35 +855,15 @@ static long modbus_rtu__probe_at(modbus_rtu_direction_t dir, uint8_t k, const ui
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if MODBUS_RTU__STUFFED
-    {
-        uint8_t count;
-        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
-        return k < count ? modbus_rtu__probe(layouts[k], dir, b, avail) : MODBUS_RTU__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return MODBUS_RTU__NONE;
-#endif
 }
 #endif
 
@@ -904,34 +877,25 @@ static uint8_t modbus_rtu__count(modbus_rtu_direction_t dir)
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         return 1u;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *modbus_rtu__header(modbus_rtu_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MODBUS_RTU_REQUEST:
-        switch (k) {
-        default:
-            break;
-        }
-        break;
-    case MODBUS_RTU_RESPONSE:
-        switch (k) {
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {NULL};
+    static const uint8_t requests_len[] = {0u};
+    static const uint8_t *const responses[] = {NULL};
+    static const uint8_t responses_len[] = {0u};
+    if (dir == MODBUS_RTU_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -940,10 +904,8 @@ static int modbus_rtu__has_command(modbus_rtu_direction_t dir, uint8_t k)
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -992,35 +954,15 @@ static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const ui
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if MODBUS_RTU__STUFFED
-    {
-        uint8_t count;
-        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
-        if (k < count) {
-            return modbus_rtu__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return MODBUS_RTU_E_ARG;
-#else
-    return MODBUS_RTU_E_ARG;
-#endif
 }
 
 
@@ -1584,7 +1526,7 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
         }
         default: return MODBUS_RTU_E_UNKNOWN;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         if (code >= 0 && ((unsigned long)code & 128UL) != 0u) {
             out->u.exception_response.function = (uint8_t)((unsigned long)code & 127UL);
             out->kind = MODBUS_RTU_EXCEPTION_RESPONSE; r = modbus_rtu__dec_exception_response(c, n, &out->u.exception_response); out->u.exception_response.unit = (uint8_t)values[0]; return r;
@@ -1622,8 +1564,6 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
         }
         default: return MODBUS_RTU_E_UNKNOWN;
         }
-    default:
-        return MODBUS_RTU_E_ARG;
     }
 }
 
@@ -1643,9 +1583,6 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
         return MODBUS_RTU_E_ARG;
     }
     count = modbus_rtu__count(dir);
-    if (count == 0u) {
-        return MODBUS_RTU_E_ARG;
-    }
     k = 0u;
     if (!MODBUS_RTU__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

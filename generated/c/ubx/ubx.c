@@ -57,10 +57,8 @@ uint16_t ubx_fletcher256(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t ubx__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(ubx_fletcher256(0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -79,6 +77,7 @@ static uint32_t ubx__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!UBX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if UBX_ENABLE_DECODE || UBX__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int ubx__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -90,6 +89,7 @@ static int ubx__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define UBX__T(L) (UBX__STUFFED && (L)->has_t)
@@ -651,12 +651,9 @@ static const ubx__layout_t *const *ubx__layouts(ubx_direction_t dir, uint8_t *co
     case UBX_REQUEST:
         *count = 1u;
         return ubx__layouts_request;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         *count = 1u;
         return ubx__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -766,7 +763,7 @@ static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, 
         default:
             return UBX__NONE;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L:
             size = 16L;
@@ -786,8 +783,6 @@ static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, 
         default:
             return UBX__NONE;
         }
-    default:
-        return UBX__NONE;
     }
 }
 #endif
@@ -807,7 +802,7 @@ static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high
         case 2564L: *low = 0u; *high = 0u; *bounded = 1; return 1;
         default: return 0;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L: *low = 16u; *high = 16u; *bounded = 1; return 1;
         case 263L: *low = 92u; *high = 92u; *bounded = 1; return 1;
@@ -818,8 +813,6 @@ static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high
         case 2564L: *low = 40u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -871,35 +864,15 @@ static long ubx__probe_at(ubx_direction_t dir, uint8_t k, const uint8_t *b, size
     switch (dir) {
     case UBX_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if UBX__STUFFED
-    {
-        uint8_t count;
-        const ubx__layout_t *const *layouts = ubx__layouts(dir, &count);
-        return k < count ? ubx__probe(layouts[k], dir, b, avail) : UBX__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return UBX__NONE;
-#endif
 }
 #endif
 
@@ -914,40 +887,25 @@ static uint8_t ubx__count(ubx_direction_t dir)
     switch (dir) {
     case UBX_REQUEST:
         return 1u;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *ubx__header(ubx_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case UBX_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return ubx__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case UBX_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return ubx__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {ubx__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {ubx__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == UBX_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -956,10 +914,8 @@ static int ubx__has_command(ubx_direction_t dir, uint8_t k)
     switch (dir) {
     case UBX_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1010,35 +966,15 @@ static int ubx__unwrap_at(ubx_direction_t dir, uint8_t k, const uint8_t *frame, 
     switch (dir) {
     case UBX_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if UBX__STUFFED
-    {
-        uint8_t count;
-        const ubx__layout_t *const *layouts = ubx__layouts(dir, &count);
-        if (k < count) {
-            return ubx__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return UBX_E_ARG;
-#else
-    return UBX_E_ARG;
-#endif
 }
 
 
@@ -1527,7 +1463,7 @@ static int ubx__decode_content(ubx_direction_t dir, long code, ubx_kind_t expect
         }
         default: return UBX_E_UNKNOWN;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L: {
             out->kind = UBX_NAV_STATUS_RESPONSE; r = ubx__dec_nav_status_response(c, n, &out->u.nav_status_response);  return r;
@@ -1552,8 +1488,6 @@ static int ubx__decode_content(ubx_direction_t dir, long code, ubx_kind_t expect
         }
         default: return UBX_E_UNKNOWN;
         }
-    default:
-        return UBX_E_ARG;
     }
 }
 
@@ -1573,9 +1507,6 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
         return UBX_E_ARG;
     }
     count = ubx__count(dir);
-    if (count == 0u) {
-        return UBX_E_ARG;
-    }
     k = 0u;
     if (!UBX__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -59,10 +59,8 @@ uint16_t vesc_crc_16_xmodem(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(vesc_crc_16_xmodem(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +79,7 @@ static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!VESC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if VESC_ENABLE_DECODE || VESC__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +91,7 @@ static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define VESC__T(L) (VESC__STUFFED && (L)->has_t)
@@ -683,12 +683,9 @@ static const vesc__layout_t *const *vesc__layouts(vesc_direction_t dir, uint8_t 
     case VESC_REQUEST:
         *count = 2u;
         return vesc__layouts_request;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         *count = 2u;
         return vesc__layouts_response;
-    default:
-        *count = 0u;
-        return NULL;
     }
 }
 #endif
@@ -816,7 +813,7 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
         default:
             return VESC__NONE;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 4L:
             size = 73L;
@@ -827,8 +824,6 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
         default:
             return VESC__NONE;
         }
-    default:
-        return VESC__NONE;
     }
 }
 #endif
@@ -852,7 +847,7 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
         case 34L: *low = 1u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 0L: *low = 28u; *high = 0u; *bounded = 0; return 1;
         case 4L: *low = 73u; *high = 73u; *bounded = 1; return 1;
@@ -860,8 +855,6 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
         case 22L: *low = 4u; *high = 4u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -951,37 +944,17 @@ static long vesc__probe_at(vesc_direction_t dir, uint8_t k, const uint8_t *b, si
         switch (k) {
         case 0u:
             return vesc__probe_request_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return vesc__probe_request_1(b, avail);
-        default:
-            break;
         }
-        break;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (k) {
         case 0u:
             return vesc__probe_response_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return vesc__probe_response_1(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if VESC__STUFFED
-    {
-        uint8_t count;
-        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
-        return k < count ? vesc__probe(layouts[k], dir, b, avail) : VESC__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return VESC__NONE;
-#endif
 }
 #endif
 
@@ -998,46 +971,25 @@ static uint8_t vesc__count(vesc_direction_t dir)
     switch (dir) {
     case VESC_REQUEST:
         return 2u;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         return 2u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *vesc__header(vesc_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case VESC_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return vesc__h_request_0;
-        case 1u:
-            *len = 1u;
-            return vesc__h_request_1;
-        default:
-            break;
-        }
-        break;
-    case VESC_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return vesc__h_response_0;
-        case 1u:
-            *len = 1u;
-            return vesc__h_response_1;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {vesc__h_request_0, vesc__h_request_1};
+    static const uint8_t requests_len[] = {1u, 1u};
+    static const uint8_t *const responses[] = {vesc__h_response_0, vesc__h_response_1};
+    static const uint8_t responses_len[] = {1u, 1u};
+    if (dir == VESC_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1046,10 +998,8 @@ static int vesc__has_command(vesc_direction_t dir, uint8_t k)
     switch (dir) {
     case VESC_REQUEST:
         return ((3UL >> k) & 1u) != 0u;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         return ((3UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1140,37 +1090,17 @@ static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const uint8_t *frame
         switch (k) {
         case 0u:
             return vesc__unwrap_request_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return vesc__unwrap_request_1(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (k) {
         case 0u:
             return vesc__unwrap_response_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return vesc__unwrap_response_1(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if VESC__STUFFED
-    {
-        uint8_t count;
-        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
-        if (k < count) {
-            return vesc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return VESC_E_ARG;
-#else
-    return VESC_E_ARG;
-#endif
 }
 
 
@@ -1587,7 +1517,7 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
         }
         default: return VESC_E_UNKNOWN;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 0L: {
             out->kind = VESC_FW_VERSION_RESPONSE; r = vesc__dec_fw_version_response(c, n, &out->u.fw_version_response);  return r;
@@ -1603,8 +1533,6 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
         }
         default: return VESC_E_UNKNOWN;
         }
-    default:
-        return VESC_E_ARG;
     }
 }
 
@@ -1624,9 +1552,6 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
         return VESC_E_ARG;
     }
     count = vesc__count(dir);
-    if (count == 0u) {
-        return VESC_E_ARG;
-    }
     k = 0u;
     if (!VESC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -17,6 +17,7 @@ HEAD = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/frami
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!PFX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if PFX_ENABLE_DECODE || PFX__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -28,6 +29,7 @@ static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define PFX__T(L) (PFX__STUFFED && (L)->has_t)

@@ -1042,10 +1042,11 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     if (count == 0u) {{ /* a direction the protocol has no frames for */
         return {P}_E_ARG;
     }}"""
+    last = header_returns[-1].replace("\n        ", "\n    ")  # the last direction's (or the one's): no test
     header_dispatch = (
-        f"if (dir == {P}_{directions(protocol)[0].name}) {{\n        {header_returns[0]}\n    }}\n    {header_returns[1].replace(chr(10) + '        ', chr(10) + '    ')}"
+        f"if (dir == {P}_{directions(protocol)[0].name}) {{\n        {header_returns[0]}\n    }}\n    {last}"
         if len(header_returns) == 2
-        else f"(void)dir;\n    {header_returns[0].replace(chr(10) + '        ', chr(10) + '    ')}"
+        else f"(void)dir;\n    {last}"
     )
     probe_rest = f"""
 #if {P}__STUFFED

@@ -23,6 +23,7 @@ typedef char crsf__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define CRSF__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define CRSF__STUFFED 0 /* some layout has byte stuffing */
 #define CRSF__LENGTHS 1 /* every layout has a length element */
+#define CRSF__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define CRSF__SINGLE 1 /* one layout per direction */
 #define CRSF__TABLES (CRSF_ENABLE_ENCODE || CRSF__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (CRSF_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -528,7 +529,9 @@ static int crsf__unwrap(const crsf__layout_t *L, const uint8_t *frame, size_t n,
 
 #if CRSF_ENABLE_PARSER && CRSF__STUFFED
 static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if CRSF__SIZED
 static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): CRSF__WAIT for more bytes, CRSF__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -605,6 +608,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
         }
         return CRSF__WAIT;
     }
+#if CRSF__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = crsf__content_size(dir, code, b + before, avail - before);
@@ -616,6 +620,9 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
         }
         return (long)L->overhead + size;
     }
+#else
+    return CRSF__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -653,9 +660,12 @@ static const crsf__layout_t *const *crsf__layouts(crsf_direction_t dir, uint8_t 
     case CRSF_REQUEST:
         *count = 1u;
         return crsf__layouts_request;
-    default: /* CRSF_RESPONSE */
+    case CRSF_RESPONSE:
         *count = 1u;
         return crsf__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -786,7 +796,7 @@ static int crsf__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if CRSF_ENABLE_PARSER && (CRSF__STUFFED || !CRSF__LENGTHS)
+#if CRSF_ENABLE_PARSER && CRSF__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

@@ -23,6 +23,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__KEEP 2u      /* bytes kept at the end that could begin a header */
 #define DYNAMIXEL_P2__STUFFED 1 /* some layout has byte stuffing */
 #define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
+#define DYNAMIXEL_P2__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
 #define DYNAMIXEL_P2__TABLES (DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (DYNAMIXEL_P2_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -528,7 +529,9 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
 
 #if DYNAMIXEL_P2_ENABLE_PARSER && DYNAMIXEL_P2__STUFFED
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if DYNAMIXEL_P2__SIZED
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): DYNAMIXEL_P2__WAIT for more bytes, DYNAMIXEL_P2__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -605,6 +608,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         }
         return DYNAMIXEL_P2__WAIT;
     }
+#if DYNAMIXEL_P2__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = dynamixel_p2__content_size(dir, code, b + before, avail - before);
@@ -616,6 +620,9 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return DYNAMIXEL_P2__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -673,9 +680,12 @@ static const dynamixel_p2__layout_t *const *dynamixel_p2__layouts(dynamixel_p2_d
     case DYNAMIXEL_P2_REQUEST:
         *count = 1u;
         return dynamixel_p2__layouts_request;
-    default: /* DYNAMIXEL_P2_RESPONSE */
+    case DYNAMIXEL_P2_RESPONSE:
         *count = 1u;
         return dynamixel_p2__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -696,7 +706,7 @@ static void dynamixel_p2__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_PARSER && (DYNAMIXEL_P2__STUFFED || !DYNAMIXEL_P2__LENGTHS)
+#if DYNAMIXEL_P2_ENABLE_PARSER && DYNAMIXEL_P2__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

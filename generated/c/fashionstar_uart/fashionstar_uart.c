@@ -23,6 +23,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define FASHIONSTAR_UART__STUFFED 0 /* some layout has byte stuffing */
 #define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
+#define FASHIONSTAR_UART__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
 #define FASHIONSTAR_UART__TABLES (FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FASHIONSTAR_UART_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -524,7 +525,9 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
 
 #if FASHIONSTAR_UART_ENABLE_PARSER && FASHIONSTAR_UART__STUFFED
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if FASHIONSTAR_UART__SIZED
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): FASHIONSTAR_UART__WAIT for more bytes, FASHIONSTAR_UART__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -601,6 +604,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         }
         return FASHIONSTAR_UART__WAIT;
     }
+#if FASHIONSTAR_UART__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = fashionstar_uart__content_size(dir, code, b + before, avail - before);
@@ -612,6 +616,9 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         }
         return (long)L->overhead + size;
     }
+#else
+    return FASHIONSTAR_UART__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -649,9 +656,12 @@ static const fashionstar_uart__layout_t *const *fashionstar_uart__layouts(fashio
     case FASHIONSTAR_UART_REQUEST:
         *count = 1u;
         return fashionstar_uart__layouts_request;
-    default: /* FASHIONSTAR_UART_RESPONSE */
+    case FASHIONSTAR_UART_RESPONSE:
         *count = 1u;
         return fashionstar_uart__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -694,7 +704,7 @@ static void fashionstar_uart__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_PARSER && (FASHIONSTAR_UART__STUFFED || !FASHIONSTAR_UART__LENGTHS)
+#if FASHIONSTAR_UART_ENABLE_PARSER && FASHIONSTAR_UART__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

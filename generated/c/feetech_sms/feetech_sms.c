@@ -23,6 +23,7 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define FEETECH_SMS__STUFFED 0 /* some layout has byte stuffing */
 #define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
+#define FEETECH_SMS__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FEETECH_SMS__SINGLE 1 /* one layout per direction */
 #define FEETECH_SMS__TABLES (FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FEETECH_SMS_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -524,7 +525,9 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
 
 #if FEETECH_SMS_ENABLE_PARSER && FEETECH_SMS__STUFFED
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if FEETECH_SMS__SIZED
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): FEETECH_SMS__WAIT for more bytes, FEETECH_SMS__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -601,6 +604,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         }
         return FEETECH_SMS__WAIT;
     }
+#if FEETECH_SMS__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = feetech_sms__content_size(dir, code, b + before, avail - before);
@@ -612,6 +616,9 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         }
         return (long)L->overhead + size;
     }
+#else
+    return FEETECH_SMS__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -651,9 +658,12 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
     case FEETECH_SMS_REQUEST:
         *count = 1u;
         return feetech_sms__layouts_request;
-    default: /* FEETECH_SMS_RESPONSE */
+    case FEETECH_SMS_RESPONSE:
         *count = 1u;
         return feetech_sms__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -674,7 +684,7 @@ static void feetech_sms__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_PARSER && (FEETECH_SMS__STUFFED || !FEETECH_SMS__LENGTHS)
+#if FEETECH_SMS_ENABLE_PARSER && FEETECH_SMS__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

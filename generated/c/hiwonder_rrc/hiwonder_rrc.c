@@ -23,6 +23,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define HIWONDER_RRC__STUFFED 0 /* some layout has byte stuffing */
 #define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
+#define HIWONDER_RRC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
 #define HIWONDER_RRC__TABLES (HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (HIWONDER_RRC_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -528,7 +529,9 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
 
 #if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__STUFFED
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if HIWONDER_RRC__SIZED
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): HIWONDER_RRC__WAIT for more bytes, HIWONDER_RRC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -605,6 +608,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         }
         return HIWONDER_RRC__WAIT;
     }
+#if HIWONDER_RRC__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = hiwonder_rrc__content_size(dir, code, b + before, avail - before);
@@ -616,6 +620,9 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return HIWONDER_RRC__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -653,9 +660,12 @@ static const hiwonder_rrc__layout_t *const *hiwonder_rrc__layouts(hiwonder_rrc_d
     case HIWONDER_RRC_REQUEST:
         *count = 1u;
         return hiwonder_rrc__layouts_request;
-    default: /* HIWONDER_RRC_RESPONSE */
+    case HIWONDER_RRC_RESPONSE:
         *count = 1u;
         return hiwonder_rrc__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -716,7 +726,7 @@ static uint32_t hiwonder_rrc__f32bits(float f)
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_PARSER && (HIWONDER_RRC__STUFFED || !HIWONDER_RRC__LENGTHS)
+#if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

@@ -23,6 +23,7 @@ typedef char mavlink_common__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MAVLINK_COMMON__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MAVLINK_COMMON__STUFFED 0 /* some layout has byte stuffing */
 #define MAVLINK_COMMON__LENGTHS 1 /* every layout has a length element */
+#define MAVLINK_COMMON__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MAVLINK_COMMON__SINGLE 0 /* one layout per direction */
 #define MAVLINK_COMMON__TABLES (MAVLINK_COMMON_ENABLE_ENCODE || MAVLINK_COMMON__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MAVLINK_COMMON_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -574,7 +575,9 @@ static int mavlink_common__unwrap(const mavlink_common__layout_t *L, const uint8
 
 #if MAVLINK_COMMON_ENABLE_PARSER && MAVLINK_COMMON__STUFFED
 static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MAVLINK_COMMON__SIZED
 static long mavlink_common__content_size(mavlink_common_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MAVLINK_COMMON__WAIT for more bytes, MAVLINK_COMMON__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -651,6 +654,7 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
         }
         return MAVLINK_COMMON__WAIT;
     }
+#if MAVLINK_COMMON__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = mavlink_common__content_size(dir, code, b + before, avail - before);
@@ -662,6 +666,9 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
         }
         return (long)L->overhead + size;
     }
+#else
+    return MAVLINK_COMMON__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -759,9 +766,12 @@ static const mavlink_common__layout_t *const *mavlink_common__layouts(mavlink_co
     case MAVLINK_COMMON_REQUEST:
         *count = 2u;
         return mavlink_common__layouts_request;
-    default: /* MAVLINK_COMMON_RESPONSE */
+    case MAVLINK_COMMON_RESPONSE:
         *count = 2u;
         return mavlink_common__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -862,7 +872,7 @@ static int mavlink_common__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if MAVLINK_COMMON_ENABLE_PARSER && (MAVLINK_COMMON__STUFFED || !MAVLINK_COMMON__LENGTHS)
+#if MAVLINK_COMMON_ENABLE_PARSER && MAVLINK_COMMON__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long mavlink_common__content_size(mavlink_common_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

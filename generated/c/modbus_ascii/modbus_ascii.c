@@ -23,6 +23,7 @@ typedef char modbus_ascii__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_ASCII__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MODBUS_ASCII__STUFFED 1 /* some layout has byte stuffing */
 #define MODBUS_ASCII__LENGTHS 0 /* every layout has a length element */
+#define MODBUS_ASCII__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MODBUS_ASCII__SINGLE 1 /* one layout per direction */
 #define MODBUS_ASCII__TABLES (MODBUS_ASCII_ENABLE_ENCODE || MODBUS_ASCII__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MODBUS_ASCII_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -586,7 +587,9 @@ static int modbus_ascii__unwrap(const modbus_ascii__layout_t *L, const uint8_t *
 
 #if MODBUS_ASCII_ENABLE_PARSER && MODBUS_ASCII__STUFFED
 static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MODBUS_ASCII__SIZED
 static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MODBUS_ASCII__WAIT for more bytes, MODBUS_ASCII__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -663,6 +666,7 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
         }
         return MODBUS_ASCII__WAIT;
     }
+#if MODBUS_ASCII__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = modbus_ascii__content_size(dir, code, b + before, avail - before);
@@ -674,6 +678,9 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return MODBUS_ASCII__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -717,9 +724,12 @@ static const modbus_ascii__layout_t *const *modbus_ascii__layouts(modbus_ascii_d
     case MODBUS_ASCII_REQUEST:
         *count = 1u;
         return modbus_ascii__layouts_request;
-    default: /* MODBUS_ASCII_RESPONSE */
+    case MODBUS_ASCII_RESPONSE:
         *count = 1u;
         return modbus_ascii__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -740,7 +750,7 @@ static void modbus_ascii__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if MODBUS_ASCII_ENABLE_PARSER && (MODBUS_ASCII__STUFFED || !MODBUS_ASCII__LENGTHS)
+#if MODBUS_ASCII_ENABLE_PARSER && MODBUS_ASCII__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

@@ -23,6 +23,7 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_RTU__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MODBUS_RTU__STUFFED 0 /* some layout has byte stuffing */
 #define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
+#define MODBUS_RTU__SIZED 1 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MODBUS_RTU__SINGLE 1 /* one layout per direction */
 #define MODBUS_RTU__TABLES (MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MODBUS_RTU_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -528,7 +529,9 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
 
 #if MODBUS_RTU_ENABLE_PARSER && MODBUS_RTU__STUFFED
 static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MODBUS_RTU__SIZED
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MODBUS_RTU__WAIT for more bytes, MODBUS_RTU__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -605,6 +608,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         }
         return MODBUS_RTU__WAIT;
     }
+#if MODBUS_RTU__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = modbus_rtu__content_size(dir, code, b + before, avail - before);
@@ -616,6 +620,9 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         }
         return (long)L->overhead + size;
     }
+#else
+    return MODBUS_RTU__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -649,9 +656,12 @@ static const modbus_rtu__layout_t *const *modbus_rtu__layouts(modbus_rtu_directi
     case MODBUS_RTU_REQUEST:
         *count = 1u;
         return modbus_rtu__layouts_request;
-    default: /* MODBUS_RTU_RESPONSE */
+    case MODBUS_RTU_RESPONSE:
         *count = 1u;
         return modbus_rtu__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -672,7 +682,7 @@ static void modbus_rtu__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_PARSER && (MODBUS_RTU__STUFFED || !MODBUS_RTU__LENGTHS)
+#if MODBUS_RTU_ENABLE_PARSER && MODBUS_RTU__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

@@ -23,6 +23,7 @@ typedef char ubx__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define UBX__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define UBX__STUFFED 0 /* some layout has byte stuffing */
 #define UBX__LENGTHS 1 /* every layout has a length element */
+#define UBX__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define UBX__SINGLE 1 /* one layout per direction */
 #define UBX__TABLES (UBX_ENABLE_ENCODE || UBX__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (UBX_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -526,7 +527,9 @@ static int ubx__unwrap(const ubx__layout_t *L, const uint8_t *frame, size_t n, u
 
 #if UBX_ENABLE_PARSER && UBX__STUFFED
 static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if UBX__SIZED
 static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): UBX__WAIT for more bytes, UBX__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -603,6 +606,7 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
         }
         return UBX__WAIT;
     }
+#if UBX__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = ubx__content_size(dir, code, b + before, avail - before);
@@ -614,6 +618,9 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
         }
         return (long)L->overhead + size;
     }
+#else
+    return UBX__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -651,9 +658,12 @@ static const ubx__layout_t *const *ubx__layouts(ubx_direction_t dir, uint8_t *co
     case UBX_REQUEST:
         *count = 1u;
         return ubx__layouts_request;
-    default: /* UBX_RESPONSE */
+    case UBX_RESPONSE:
         *count = 1u;
         return ubx__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -740,7 +750,7 @@ static int ubx__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if UBX_ENABLE_PARSER && (UBX__STUFFED || !UBX__LENGTHS)
+#if UBX_ENABLE_PARSER && UBX__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

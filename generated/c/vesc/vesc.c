@@ -23,6 +23,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define VESC__STUFFED 0 /* some layout has byte stuffing */
 #define VESC__LENGTHS 1 /* every layout has a length element */
+#define VESC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define VESC__SINGLE 0 /* one layout per direction */
 #define VESC__TABLES (VESC_ENABLE_ENCODE || VESC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (VESC_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -528,7 +529,9 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
 
 #if VESC_ENABLE_PARSER && VESC__STUFFED
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if VESC__SIZED
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): VESC__WAIT for more bytes, VESC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -605,6 +608,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         }
         return VESC__WAIT;
     }
+#if VESC__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = vesc__content_size(dir, code, b + before, avail - before);
@@ -616,6 +620,9 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         }
         return (long)L->overhead + size;
     }
+#else
+    return VESC__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -683,9 +690,12 @@ static const vesc__layout_t *const *vesc__layouts(vesc_direction_t dir, uint8_t 
     case VESC_REQUEST:
         *count = 2u;
         return vesc__layouts_request;
-    default: /* VESC_RESPONSE */
+    case VESC_RESPONSE:
         *count = 2u;
         return vesc__layouts_response;
+    default:
+        *count = 0u;
+        return NULL;
     }
 }
 #endif
@@ -772,7 +782,7 @@ static int vesc__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if VESC_ENABLE_PARSER && (VESC__STUFFED || !VESC__LENGTHS)
+#if VESC_ENABLE_PARSER && VESC__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {

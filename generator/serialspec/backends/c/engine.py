@@ -446,7 +446,9 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
 
 #if PFX_ENABLE_PARSER && PFX__STUFFED
 static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if PFX__SIZED
 static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): PFX__WAIT for more bytes, PFX__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -523,6 +525,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         }
         return PFX__WAIT;
     }
+#if PFX__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = pfx__content_size(dir, code, b + before, avail - before);
@@ -534,6 +537,9 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         }
         return (long)L->overhead + size;
     }
+#else
+    return PFX__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 """

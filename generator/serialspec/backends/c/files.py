@@ -947,6 +947,10 @@ static size_t {p}__least({p}_direction_t dir)
     extras_decl = f"\n    const uint8_t *extras[{optionals}];" if opt else ""
     find_extras = "\n    " + f"{p}__extras(dir, k, frame, len, extras);" if opt else ""
     all_lengths = int(all(layout.length is not None for layout in every))
+    # a layout without a length is sized by its content (the probe's size rules) unless stuffed and ended by a
+    # trailer (the engine's probe finds that first)
+    trailed = [bool(layout.transparency) and len(layout.elements) > 1 and layout.elements[-1].fixed for layout in every]
+    sized = any(layout.length is None and not t for layout, t in zip(every, trailed, strict=True))
     single = int(all(n == 1 for n in n_layouts.values()))
     text = f"""{banner(protocol)}
 #include "{p}.h"
@@ -969,6 +973,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__KEEP {keep}u      /* bytes kept at the end that could begin a header */
 #define {P}__STUFFED {int(any_stuffed)} /* some layout has byte stuffing */
 #define {P}__LENGTHS {all_lengths} /* every layout has a length element */
+#define {P}__SIZED {int(sized)} /* some layout's size follows from its content's leading fields (a size rule) */
 #define {P}__SINGLE {single} /* one layout per direction */
 #define {P}__TABLES ({P}_ENABLE_ENCODE || {P}__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes ({P}_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -1004,14 +1009,14 @@ static uint32_t {p}__check(uint8_t which, const uint8_t *d, size_t n)
 static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *count)
 {{
     switch (dir) {{
-{switch_cases(dir_layouts, both, "    default:" + chr(10) + "        *count = 0u;" + chr(10) + "        return NULL;")}
+{switch_cases(dir_layouts, False, "    default:" + chr(10) + "        *count = 0u;" + chr(10) + "        return NULL;")}
     }}
 }}
 #endif
 #endif
 
 {helpers}
-#if {P}_ENABLE_PARSER && ({P}__STUFFED || !{P}__LENGTHS)
+#if {P}_ENABLE_PARSER && {P}__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, size_t avail)
 {{

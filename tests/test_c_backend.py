@@ -29,7 +29,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends.c import length_byte
 from serialspec.backends.c.build import files as c_files
-from serialspec.lang.model import Direction, Message
+from serialspec.backends.c.emit import messages as c_messages
+from serialspec.backends.c.emit import msg_id
+from serialspec.lang.model import Direction, Message, TableValue, Text
 from serialspec.runtime.errors import DecodeError
 from strategies import message_fields
 
@@ -441,6 +443,58 @@ def test_random_messages_encode_and_decode_as_python_does(g: Generated, spec: Me
         check_decode_agrees(g, mutated, spec.direction)
 
     agree()
+
+
+TABLE_VALUES = by_protocol(
+    [(g, m) for g in C_SPECS for m in g.protocol.messages() if any(isinstance(f, TableValue) for f in m.fields)]
+)
+
+
+@pytest.mark.parametrize(("g", "spec"), TABLE_VALUES)
+def test_every_key_of_a_table_value_encodes_and_decodes_as_python_does(g: Generated, spec: Message) -> None:
+    """A value typed by a table (FashionStar's data by data_id): each key's type at its least and greatest value
+    through the Python codec and the C (a few random messages reach only a few of the keys' cases)."""
+
+    @settings(max_examples=1, deadline=None, derandomize=True)
+    @given(message_fields(g.protocol, spec))
+    def each_key(fields: dict[str, Any]) -> None:
+        for f in spec.fields:
+            if isinstance(f, TableValue):
+                for entry in (e for e in f.table.entries if not e.reserved):
+                    for value in (entry.minimum, entry.maximum):
+                        number = value if entry.type.is_float else int(value)
+                        agrees_with_python(
+                            driver(g.protocol.name), g, spec, {**fields, f.key: entry.key, f.name: number}
+                        )
+
+    each_key()
+
+
+WIDE = "é€😀"  # UTF-8 of 2, 3 and 4 bytes
+
+
+def wide_text(f: Any) -> bool:
+    """A text the wide characters fit: NUL-terminated, the rest of the content, or padded to room for them."""
+    return isinstance(f, Text) and (
+        f.size in (None, "rest") or (isinstance(f.size, int) and f.pad is not None and f.size >= 9)
+    )
+
+
+WIDE_TEXTS = by_protocol([(g, m) for g in C_SPECS for m in g.protocol.messages() if any(map(wide_text, m.fields))])
+
+
+@pytest.mark.parametrize(("g", "spec"), WIDE_TEXTS)
+def test_text_of_characters_past_ascii_encodes_and_decodes_as_python_does(g: Generated, spec: Message) -> None:
+    """Texts of 2-, 3- and 4-byte UTF-8 characters through the Python codec and the C (random texts are ASCII:
+    the C's UTF-8 check of each longer form ran nowhere else)."""
+
+    @settings(max_examples=1, deadline=None, derandomize=True)
+    @given(message_fields(g.protocol, spec))
+    def wide(fields: dict[str, Any]) -> None:
+        texts = {f.name: WIDE for f in spec.fields if wide_text(f)}
+        agrees_with_python(driver(g.protocol.name), g, spec, {**fields, **texts})
+
+    wide()
 
 
 def mutate(frame: bytes, data: st.DataObject) -> bytes:
@@ -885,6 +939,18 @@ def test_feature_switches_leave_out_encode_decode_or_parser_without_a_warning(g:
         assert run.returncode == 0 and not run.stderr, run.stderr.decode()
 
 
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_api_refuses_null_pointers_and_values_outside_its_enums(g: Generated) -> None:
+    """decode and encode given NULL, a direction or a kind no enum value names: E_ARG, nothing written; the names of
+    no kind and no result: ""; to_json(NULL): null; a parser made for no direction finds nothing."""
+    (answer,) = driver(g.protocol.name).ask("args request")
+    words = answer.split(" ")
+    assert words[:9] == ["args", *["E_ARG"] * 6, "0", "[]"], answer
+    assert words[9:12] == ["[]", "[]", "[]"], answer
+    assert words[12] == "null" and words[13].startswith("{"), answer
+    assert words[-3:] == ["1", "0", "0"], answer  # the byte taken, no message, no event
+
+
 ROLES = ("HOST", "DEVICE")
 
 
@@ -914,9 +980,28 @@ def test_a_build_for_one_role_keeps_its_side_and_refuses_the_other(g: Generated,
         run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
         assert run.returncode == 0 and run.stdout.endswith(" 0 failed\n"), run.stdout + run.stderr
     full = driver(name)
-    one = Driver(name, GENERATED_C / name, tmp_path, defines=(role_define,))
+    each = tmp_path / "each.h"  # every message's own encoder, called with a zeroed message
+    calls = [
+        f'    {{ static {name}_{msg_id(m)}_t m; printf(" {msg_id(m)}=%s", '
+        f"{name}_result_name({name}_encode_{msg_id(m)}(&m, b, sizeof(b), &n))); }}"
+        for m in c_messages(g.protocol)
+    ]
+    each.write_text(
+        "static void each_encoder(void)\n{\n    static uint8_t b[1 << 16];\n    size_t n;\n"
+        '    printf("each");\n' + "\n".join(calls) + '\n    printf("\\n");\n}\n'
+    )
+    one = Driver(name, GENERATED_C / name, tmp_path, defines=(role_define, f'-DDRIVER_EACH="{each}"'))
     reads = Direction.RESPONSE if role == "HOST" else Direction.REQUEST
     try:
+        # every kind, zeroed: the side the role sends encodes as in the full build, the other is refused, through
+        # encode and through each message's own encoder
+        (every,) = full.ask("kinds request")
+        (kept,) = one.ask("kinds request")
+        (own,) = one.ask("each request")
+        for both, this, alone in zip(every.split()[1:], kept.split()[1:], own.split()[1:], strict=True):
+            refused = both.split("=")[0].endswith(f"_{reads.value}")
+            assert this == alone == (both.split("=")[0] + "=E_ARG" if refused else both), (both, this, alone)
+        assert one.ask("args request") == full.ask("args request")
         for example in g.protocol.examples:
             d, frame = example.direction.value, example.frame.hex()
             kind = kind_of(g, example_class(g, example))

@@ -10,6 +10,10 @@
  *   enc1 DIR HEX CAP         decode, then encode into CAP bytes with canary bytes after them: "ok <hex>" / "err <r>"
  *   raw DIR HEX [KIND]       decode: "ok <the msg_t's bytes in hex>" or "err <result>" (for encraw in another build)
  *   encraw DIR HEX           a msg_t from its bytes in hex (raw's, same compiler), encoded: "ok <hex>" / "err <r>"
+ *   args DIR                 the API given what it refuses (NULL pointers, no direction, no kind, no result), each
+ *                            answer: "args <result or text> ..." (one line)
+ *   kinds DIR                every kind encoded from a zeroed message: "kinds <kind>=<result> ..." (one line)
+ *   each DIR                 with -DDRIVER_EACH="file": the file's each_encoder() (every message's own encoder called)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,6 +51,10 @@ static void puthex(const uint8_t *b, size_t n)
         printf("%02x", b[i]);
     }
 }
+
+#ifdef DRIVER_EACH
+#include DRIVER_EACH
+#endif
 
 static P(kind_t) kind_of(const char *name)
 {
@@ -221,6 +229,45 @@ int main(void)
             }
             printf("end %lu %lu %lu %lu\n", (unsigned long)parser.frames, (unsigned long)parser.garbage,
                    (unsigned long)parser.errors, (unsigned long)parser.n);
+        } else if (strcmp(cmd, "args") == 0) {
+            size_t len = 1u;
+            bool got = true;
+            P(direction_t) none = (P(direction_t))7; /* no direction */
+            memset(&msg, 0, sizeof(msg));
+            frame[0] = 0u;
+            printf("args %s", P(result_name)(P(decode)(NULL, 0u, dir, &msg)));
+            printf(" %s", P(result_name)(P(decode)(frame, 1u, dir, NULL)));
+            printf(" %s", P(result_name)(P(decode)(frame, 1u, none, &msg)));
+            printf(" %s", P(result_name)(P(encode)(NULL, out, sizeof(out), &len)));
+            printf(" %s", P(result_name)(P(encode)(&msg, NULL, sizeof(out), &len)));
+            printf(" %s", P(result_name)(P(encode)(&msg, out, sizeof(out), &len)));
+            printf(" %lu", (unsigned long)len);
+            printf(" [%s]", P(kind_name)(CAT(PROTO_UPPER, _KIND_NONE)));
+            printf(" [%s]", P(kind_name)(CAT(PROTO_UPPER, _KIND_COUNT)));
+            printf(" [%s] [%s]", P(result_name)(-1), P(result_name)(1000));
+            P(to_json)(NULL, json, sizeof(json));
+            printf(" %s", json);
+            P(to_json)(&msg, json, sizeof(json));
+            printf(" %s", json);
+            P(parser_init)(&parser, none);
+            printf(" %lu", (unsigned long)P(parser_feed)(&parser, frame, 1u, &msg, &got));
+            printf(" %d", (int)got);
+            printf(" %d", (int)P(parser_push)(&parser, 0u, &msg));
+            printf("\n");
+        } else if (strcmp(cmd, "kinds") == 0) {
+            int k;
+            printf("kinds");
+            for (k = 1; k < (int)CAT(PROTO_UPPER, _KIND_COUNT); k++) {
+                size_t len = 0u;
+                memset(&msg, 0, sizeof(msg));
+                msg.kind = (P(kind_t))k;
+                printf(" %s=%s", P(kind_name)(msg.kind), P(result_name)(P(encode)(&msg, out, sizeof(out), &len)));
+            }
+            printf("\n");
+#ifdef DRIVER_EACH
+        } else if (strcmp(cmd, "each") == 0) {
+            each_encoder();
+#endif
         } else {
             printf("bad\n");
         }

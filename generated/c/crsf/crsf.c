@@ -23,6 +23,7 @@ typedef char crsf__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define CRSF__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define CRSF__STUFFED 0 /* some layout has byte stuffing */
 #define CRSF__LENGTHS 1 /* every layout has a length element */
+#define CRSF__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define CRSF__SINGLE 1 /* one layout per direction */
 #define CRSF__TABLES (CRSF_ENABLE_ENCODE || CRSF__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (CRSF_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -59,10 +60,8 @@ uint8_t crsf_crc_8_dvb_s2(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t crsf__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(crsf_crc_8_dvb_s2(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +80,7 @@ static uint32_t crsf__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!CRSF__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if CRSF_ENABLE_DECODE || CRSF__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int crsf__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +92,7 @@ static int crsf__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define CRSF__T(L) (CRSF__STUFFED && (L)->has_t)
@@ -194,7 +195,7 @@ static int crsf__inner_last(const crsf__layout_t *L)
 }
 #endif
 
-#if CRSF_ENABLE_ENCODE || CRSF__STUFFED
+#if CRSF__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int crsf__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +308,7 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
     int last = crsf__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if CRSF__STUFFED
     if (CRSF__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +344,12 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const crsf__element_t *e = &L->e[k];
+#if CRSF__STUFFED
         if (CRSF__T(L) && k == L->t_first) {
             size_t made;
             if (!crsf__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +368,7 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == CRSF__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return CRSF_E_BUFFER;
@@ -386,6 +391,7 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const crsf__element_t *e = &L->e[k];
@@ -523,7 +529,9 @@ static int crsf__unwrap(const crsf__layout_t *L, const uint8_t *frame, size_t n,
 
 #if CRSF_ENABLE_PARSER && CRSF__STUFFED
 static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if CRSF__SIZED
 static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): CRSF__WAIT for more bytes, CRSF__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -600,6 +608,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
         }
         return CRSF__WAIT;
     }
+#if CRSF__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = crsf__content_size(dir, code, b + before, avail - before);
@@ -611,6 +620,9 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
         }
         return (long)L->overhead + size;
     }
+#else
+    return CRSF__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -784,7 +796,7 @@ static int crsf__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if CRSF_ENABLE_PARSER && (CRSF__STUFFED || !CRSF__LENGTHS)
+#if CRSF_ENABLE_PARSER && CRSF__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -816,7 +828,7 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         default:
             return CRSF__NONE;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L:
             size = 15L;
@@ -836,8 +848,6 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         default:
             return CRSF__NONE;
         }
-    default:
-        return CRSF__NONE;
     }
 }
 #endif
@@ -858,7 +868,7 @@ static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *hi
         case 40L: *low = 2u; *high = 2u; *bounded = 1; return 1;
         default: return 0;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L: *low = 15u; *high = 15u; *bounded = 1; return 1;
         case 8L: *low = 8u; *high = 8u; *bounded = 1; return 1;
@@ -869,8 +879,6 @@ static int crsf__bounds(crsf_direction_t dir, long code, size_t *low, size_t *hi
         case 41L: *low = 17u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -920,35 +928,15 @@ static long crsf__probe_at(crsf_direction_t dir, uint8_t k, const uint8_t *b, si
     switch (dir) {
     case CRSF_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if CRSF__STUFFED
-    {
-        uint8_t count;
-        const crsf__layout_t *const *layouts = crsf__layouts(dir, &count);
-        return k < count ? crsf__probe(layouts[k], dir, b, avail) : CRSF__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return CRSF__NONE;
-#endif
 }
 #endif
 
@@ -963,40 +951,25 @@ static uint8_t crsf__count(crsf_direction_t dir)
     switch (dir) {
     case CRSF_REQUEST:
         return 1u;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *crsf__header(crsf_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case CRSF_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return crsf__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case CRSF_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return crsf__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {crsf__h_request_0};
+    static const uint8_t requests_len[] = {1u};
+    static const uint8_t *const responses[] = {crsf__h_response_0};
+    static const uint8_t responses_len[] = {1u};
+    if (dir == CRSF_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1005,10 +978,8 @@ static int crsf__has_command(crsf_direction_t dir, uint8_t k)
     switch (dir) {
     case CRSF_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1057,35 +1028,15 @@ static int crsf__unwrap_at(crsf_direction_t dir, uint8_t k, const uint8_t *frame
     switch (dir) {
     case CRSF_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return crsf__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if CRSF__STUFFED
-    {
-        uint8_t count;
-        const crsf__layout_t *const *layouts = crsf__layouts(dir, &count);
-        if (k < count) {
-            return crsf__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return CRSF_E_ARG;
-#else
-    return CRSF_E_ARG;
-#endif
 }
 
 
@@ -1546,7 +1497,7 @@ static int crsf__decode_content(crsf_direction_t dir, long code, crsf_kind_t exp
         }
         default: return CRSF_E_UNKNOWN;
         }
-    case CRSF_RESPONSE:
+    default: /* CRSF_RESPONSE */
         switch (code) {
         case 2L: {
             out->kind = CRSF_GPS_RESPONSE; r = crsf__dec_gps_response(c, n, &out->u.gps_response);  return r;
@@ -1571,8 +1522,6 @@ static int crsf__decode_content(crsf_direction_t dir, long code, crsf_kind_t exp
         }
         default: return CRSF_E_UNKNOWN;
         }
-    default:
-        return CRSF_E_ARG;
     }
 }
 
@@ -1592,9 +1541,6 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
         return CRSF_E_ARG;
     }
     count = crsf__count(dir);
-    if (count == 0u) {
-        return CRSF_E_ARG;
-    }
     k = 0u;
     if (!CRSF__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

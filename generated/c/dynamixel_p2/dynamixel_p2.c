@@ -23,6 +23,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__KEEP 2u      /* bytes kept at the end that could begin a header */
 #define DYNAMIXEL_P2__STUFFED 1 /* some layout has byte stuffing */
 #define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
+#define DYNAMIXEL_P2__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
 #define DYNAMIXEL_P2__TABLES (DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (DYNAMIXEL_P2_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -59,10 +60,8 @@ uint16_t dynamixel_p2_crc_16_umts(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(dynamixel_p2_crc_16_umts(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +80,7 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!DYNAMIXEL_P2__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if DYNAMIXEL_P2_ENABLE_DECODE || DYNAMIXEL_P2__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +92,7 @@ static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define DYNAMIXEL_P2__T(L) (DYNAMIXEL_P2__STUFFED && (L)->has_t)
@@ -194,7 +195,7 @@ static int dynamixel_p2__inner_last(const dynamixel_p2__layout_t *L)
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
+#if DYNAMIXEL_P2__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int dynamixel_p2__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +308,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     int last = dynamixel_p2__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if DYNAMIXEL_P2__STUFFED
     if (DYNAMIXEL_P2__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +344,12 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
+#if DYNAMIXEL_P2__STUFFED
         if (DYNAMIXEL_P2__T(L) && k == L->t_first) {
             size_t made;
             if (!dynamixel_p2__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +368,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == DYNAMIXEL_P2__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return DYNAMIXEL_P2_E_BUFFER;
@@ -386,6 +391,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
@@ -523,7 +529,9 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
 
 #if DYNAMIXEL_P2_ENABLE_PARSER && DYNAMIXEL_P2__STUFFED
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if DYNAMIXEL_P2__SIZED
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): DYNAMIXEL_P2__WAIT for more bytes, DYNAMIXEL_P2__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -600,6 +608,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         }
         return DYNAMIXEL_P2__WAIT;
     }
+#if DYNAMIXEL_P2__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = dynamixel_p2__content_size(dir, code, b + before, avail - before);
@@ -611,6 +620,9 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return DYNAMIXEL_P2__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -694,7 +706,7 @@ static void dynamixel_p2__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_PARSER && (DYNAMIXEL_P2__STUFFED || !DYNAMIXEL_P2__LENGTHS)
+#if DYNAMIXEL_P2_ENABLE_PARSER && DYNAMIXEL_P2__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -726,14 +738,12 @@ static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, 
         default:
             return DYNAMIXEL_P2__NONE;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
 
         default:
             return DYNAMIXEL_P2__NONE;
         }
-    default:
-        return DYNAMIXEL_P2__NONE;
     }
 }
 #endif
@@ -760,13 +770,11 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
         case 147L: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
         case DYNAMIXEL_P2__NO_CODE: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -777,7 +785,6 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
 static long dynamixel_p2__probe_at(dynamixel_p2_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
 {
     switch (dir) {
-
     default:
         break;
     }
@@ -807,40 +814,25 @@ static uint8_t dynamixel_p2__count(dynamixel_p2_direction_t dir)
     switch (dir) {
     case DYNAMIXEL_P2_REQUEST:
         return 1u;
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *dynamixel_p2__header(dynamixel_p2_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case DYNAMIXEL_P2_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 3u;
-            return dynamixel_p2__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case DYNAMIXEL_P2_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 3u;
-            return dynamixel_p2__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {dynamixel_p2__h_request_0};
+    static const uint8_t requests_len[] = {3u};
+    static const uint8_t *const responses[] = {dynamixel_p2__h_response_0};
+    static const uint8_t responses_len[] = {3u};
+    if (dir == DYNAMIXEL_P2_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -849,10 +841,8 @@ static int dynamixel_p2__has_command(dynamixel_p2_direction_t dir, uint8_t k)
     switch (dir) {
     case DYNAMIXEL_P2_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         return ((0UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -864,7 +854,6 @@ static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, cons
     (void)k;
     (void)plain;
     switch (dir) {
-
     default:
         break;
     }
@@ -1274,7 +1263,7 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
         }
         default: return DYNAMIXEL_P2_E_UNKNOWN;
         }
-    case DYNAMIXEL_P2_RESPONSE:
+    default: /* DYNAMIXEL_P2_RESPONSE */
         switch (code) {
         case DYNAMIXEL_P2__NO_CODE: {
             if (expect == DYNAMIXEL_P2_PING_RESPONSE) {
@@ -1284,8 +1273,6 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
         }
         default: return DYNAMIXEL_P2_E_UNKNOWN;
         }
-    default:
-        return DYNAMIXEL_P2_E_ARG;
     }
 }
 
@@ -1305,9 +1292,6 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
         return DYNAMIXEL_P2_E_ARG;
     }
     count = dynamixel_p2__count(dir);
-    if (count == 0u) {
-        return DYNAMIXEL_P2_E_ARG;
-    }
     k = 0u;
     if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -23,6 +23,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define FASHIONSTAR_UART__STUFFED 0 /* some layout has byte stuffing */
 #define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
+#define FASHIONSTAR_UART__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
 #define FASHIONSTAR_UART__TABLES (FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FASHIONSTAR_UART_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -55,10 +56,8 @@ uint8_t fashionstar_uart_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return ((uint32_t)(fashionstar_uart_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +76,7 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!FASHIONSTAR_UART__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if FASHIONSTAR_UART_ENABLE_DECODE || FASHIONSTAR_UART__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +88,7 @@ static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FASHIONSTAR_UART__T(L) (FASHIONSTAR_UART__STUFFED && (L)->has_t)
@@ -190,7 +191,7 @@ static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
+#if FASHIONSTAR_UART__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int fashionstar_uart__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -303,6 +304,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     int last = fashionstar_uart__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if FASHIONSTAR_UART__STUFFED
     if (FASHIONSTAR_UART__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -338,10 +340,12 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
+#if FASHIONSTAR_UART__STUFFED
         if (FASHIONSTAR_UART__T(L) && k == L->t_first) {
             size_t made;
             if (!fashionstar_uart__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -360,6 +364,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == FASHIONSTAR_UART__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return FASHIONSTAR_UART_E_BUFFER;
@@ -382,6 +387,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
@@ -519,7 +525,9 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
 
 #if FASHIONSTAR_UART_ENABLE_PARSER && FASHIONSTAR_UART__STUFFED
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if FASHIONSTAR_UART__SIZED
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): FASHIONSTAR_UART__WAIT for more bytes, FASHIONSTAR_UART__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -596,6 +604,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         }
         return FASHIONSTAR_UART__WAIT;
     }
+#if FASHIONSTAR_UART__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = fashionstar_uart__content_size(dir, code, b + before, avail - before);
@@ -607,6 +616,9 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         }
         return (long)L->overhead + size;
     }
+#else
+    return FASHIONSTAR_UART__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -692,7 +704,7 @@ static void fashionstar_uart__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_PARSER && (FASHIONSTAR_UART__STUFFED || !FASHIONSTAR_UART__LENGTHS)
+#if FASHIONSTAR_UART_ENABLE_PARSER && FASHIONSTAR_UART__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -769,7 +781,7 @@ static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, lon
         default:
             return FASHIONSTAR_UART__NONE;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -822,8 +834,6 @@ static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, lon
         default:
             return FASHIONSTAR_UART__NONE;
         }
-    default:
-        return FASHIONSTAR_UART__NONE;
     }
 }
 #endif
@@ -860,7 +870,7 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
         case 25L: *low = 3u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 1u; *bounded = 1; return 1;
         case 2L: *low = 2u; *high = 2u; *bounded = 1; return 1;
@@ -881,8 +891,6 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
         case 22L: *low = 16u; *high = 16u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -899,40 +907,25 @@ static uint8_t fashionstar_uart__count(fashionstar_uart_direction_t dir)
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         return 1u;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *fashionstar_uart__header(fashionstar_uart_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case FASHIONSTAR_UART_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return fashionstar_uart__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case FASHIONSTAR_UART_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return fashionstar_uart__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {fashionstar_uart__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {fashionstar_uart__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == FASHIONSTAR_UART_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -941,10 +934,8 @@ static int fashionstar_uart__has_command(fashionstar_uart_direction_t dir, uint8
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -995,35 +986,15 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FASHIONSTAR_UART__STUFFED
-    {
-        uint8_t count;
-        const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
-        if (k < count) {
-            return fashionstar_uart__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return FASHIONSTAR_UART_E_ARG;
-#else
-    return FASHIONSTAR_UART_E_ARG;
-#endif
 }
 
 
@@ -2334,7 +2305,7 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
         }
         default: return FASHIONSTAR_UART_E_UNKNOWN;
         }
-    case FASHIONSTAR_UART_RESPONSE:
+    default: /* FASHIONSTAR_UART_RESPONSE */
         switch (code) {
         case 1L: {
             out->kind = FASHIONSTAR_UART_PING_RESPONSE; r = fashionstar_uart__dec_ping_response(c, n, &out->u.ping_response);  return r;
@@ -2389,8 +2360,6 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
         }
         default: return FASHIONSTAR_UART_E_UNKNOWN;
         }
-    default:
-        return FASHIONSTAR_UART_E_ARG;
     }
 }
 
@@ -2410,9 +2379,6 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
         return FASHIONSTAR_UART_E_ARG;
     }
     count = fashionstar_uart__count(dir);
-    if (count == 0u) {
-        return FASHIONSTAR_UART_E_ARG;
-    }
     k = 0u;
     if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -23,6 +23,7 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define FEETECH_SMS__STUFFED 0 /* some layout has byte stuffing */
 #define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
+#define FEETECH_SMS__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FEETECH_SMS__SINGLE 1 /* one layout per direction */
 #define FEETECH_SMS__TABLES (FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FEETECH_SMS_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -55,10 +56,8 @@ uint8_t feetech_sms_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (~(uint32_t)(feetech_sms_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +76,7 @@ static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!FEETECH_SMS__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if FEETECH_SMS_ENABLE_DECODE || FEETECH_SMS__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +88,7 @@ static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FEETECH_SMS__T(L) (FEETECH_SMS__STUFFED && (L)->has_t)
@@ -190,7 +191,7 @@ static int feetech_sms__inner_last(const feetech_sms__layout_t *L)
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
+#if FEETECH_SMS__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int feetech_sms__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -303,6 +304,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     int last = feetech_sms__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if FEETECH_SMS__STUFFED
     if (FEETECH_SMS__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -338,10 +340,12 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
+#if FEETECH_SMS__STUFFED
         if (FEETECH_SMS__T(L) && k == L->t_first) {
             size_t made;
             if (!feetech_sms__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -360,6 +364,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == FEETECH_SMS__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return FEETECH_SMS_E_BUFFER;
@@ -382,6 +387,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
@@ -519,7 +525,9 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
 
 #if FEETECH_SMS_ENABLE_PARSER && FEETECH_SMS__STUFFED
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if FEETECH_SMS__SIZED
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): FEETECH_SMS__WAIT for more bytes, FEETECH_SMS__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -596,6 +604,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         }
         return FEETECH_SMS__WAIT;
     }
+#if FEETECH_SMS__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = feetech_sms__content_size(dir, code, b + before, avail - before);
@@ -607,6 +616,9 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         }
         return (long)L->overhead + size;
     }
+#else
+    return FEETECH_SMS__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -672,7 +684,7 @@ static void feetech_sms__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_PARSER && (FEETECH_SMS__STUFFED || !FEETECH_SMS__LENGTHS)
+#if FEETECH_SMS_ENABLE_PARSER && FEETECH_SMS__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -698,14 +710,12 @@ static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, co
         default:
             return FEETECH_SMS__NONE;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
 
         default:
             return FEETECH_SMS__NONE;
         }
-    default:
-        return FEETECH_SMS__NONE;
     }
 }
 #endif
@@ -727,13 +737,11 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
         case 131L: *low = 2u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
         case FEETECH_SMS__NO_CODE: *low = 0u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -750,40 +758,25 @@ static uint8_t feetech_sms__count(feetech_sms_direction_t dir)
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         return 1u;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *feetech_sms__header(feetech_sms_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case FEETECH_SMS_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return feetech_sms__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case FEETECH_SMS_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return feetech_sms__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {feetech_sms__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {feetech_sms__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == FEETECH_SMS_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -792,10 +785,8 @@ static int feetech_sms__has_command(feetech_sms_direction_t dir, uint8_t k)
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         return ((0UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -850,35 +841,15 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
     switch (dir) {
     case FEETECH_SMS_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FEETECH_SMS__STUFFED
-    {
-        uint8_t count;
-        const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
-        if (k < count) {
-            return feetech_sms__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return FEETECH_SMS_E_ARG;
-#else
-    return FEETECH_SMS_E_ARG;
-#endif
 }
 
 
@@ -1105,15 +1076,13 @@ static int feetech_sms__decode_content(feetech_sms_direction_t dir, long code, f
         }
         default: return FEETECH_SMS_E_UNKNOWN;
         }
-    case FEETECH_SMS_RESPONSE:
+    default: /* FEETECH_SMS_RESPONSE */
         switch (code) {
         case FEETECH_SMS__NO_CODE: {
             out->kind = FEETECH_SMS_REPLY_RESPONSE; r = feetech_sms__dec_reply_response(c, n, &out->u.reply_response); out->u.reply_response.id = (uint8_t)values[0]; out->u.reply_response.error = (uint8_t)values[1]; return r;
         }
         default: return FEETECH_SMS_E_UNKNOWN;
         }
-    default:
-        return FEETECH_SMS_E_ARG;
     }
 }
 
@@ -1133,9 +1102,6 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
         return FEETECH_SMS_E_ARG;
     }
     count = feetech_sms__count(dir);
-    if (count == 0u) {
-        return FEETECH_SMS_E_ARG;
-    }
     k = 0u;
     if (!FEETECH_SMS__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

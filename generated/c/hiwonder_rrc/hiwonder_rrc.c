@@ -23,6 +23,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define HIWONDER_RRC__STUFFED 0 /* some layout has byte stuffing */
 #define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
+#define HIWONDER_RRC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
 #define HIWONDER_RRC__TABLES (HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (HIWONDER_RRC_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -59,10 +60,8 @@ uint8_t hiwonder_rrc_crc_8_maxim(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(hiwonder_rrc_crc_8_maxim(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +80,7 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!HIWONDER_RRC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if HIWONDER_RRC_ENABLE_DECODE || HIWONDER_RRC__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +92,7 @@ static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define HIWONDER_RRC__T(L) (HIWONDER_RRC__STUFFED && (L)->has_t)
@@ -194,7 +195,7 @@ static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
+#if HIWONDER_RRC__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int hiwonder_rrc__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +308,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     int last = hiwonder_rrc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if HIWONDER_RRC__STUFFED
     if (HIWONDER_RRC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +344,12 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
+#if HIWONDER_RRC__STUFFED
         if (HIWONDER_RRC__T(L) && k == L->t_first) {
             size_t made;
             if (!hiwonder_rrc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +368,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == HIWONDER_RRC__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return HIWONDER_RRC_E_BUFFER;
@@ -386,6 +391,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
@@ -523,7 +529,9 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
 
 #if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__STUFFED
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if HIWONDER_RRC__SIZED
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): HIWONDER_RRC__WAIT for more bytes, HIWONDER_RRC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -600,6 +608,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         }
         return HIWONDER_RRC__WAIT;
     }
+#if HIWONDER_RRC__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = hiwonder_rrc__content_size(dir, code, b + before, avail - before);
@@ -611,6 +620,9 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return HIWONDER_RRC__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -714,7 +726,7 @@ static uint32_t hiwonder_rrc__f32bits(float f)
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_PARSER && (HIWONDER_RRC__STUFFED || !HIWONDER_RRC__LENGTHS)
+#if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -744,7 +756,7 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
         default:
             return HIWONDER_RRC__NONE;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 6L:
             size = 2L;
@@ -764,8 +776,6 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
         default:
             return HIWONDER_RRC__NONE;
         }
-    default:
-        return HIWONDER_RRC__NONE;
     }
 }
 #endif
@@ -786,7 +796,7 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
         case 11L: *low = 2u; *high = 1022u; *bounded = 1; return 1;
         default: return 0;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 4L: *low = 3u; *high = 4u; *bounded = 1; return 1;
         case 5L: *low = 4u; *high = 7u; *bounded = 1; return 1;
@@ -797,8 +807,6 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
         case 0L: *low = 3u; *high = 3u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -815,40 +823,25 @@ static uint8_t hiwonder_rrc__count(hiwonder_rrc_direction_t dir)
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         return 1u;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *hiwonder_rrc__header(hiwonder_rrc_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case HIWONDER_RRC_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return hiwonder_rrc__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case HIWONDER_RRC_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return hiwonder_rrc__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {hiwonder_rrc__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {hiwonder_rrc__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == HIWONDER_RRC_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -857,10 +850,8 @@ static int hiwonder_rrc__has_command(hiwonder_rrc_direction_t dir, uint8_t k)
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -911,35 +902,15 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
         }
-        break;
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen, 0);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if HIWONDER_RRC__STUFFED
-    {
-        uint8_t count;
-        const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
-        if (k < count) {
-            return hiwonder_rrc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return HIWONDER_RRC_E_ARG;
-#else
-    return HIWONDER_RRC_E_ARG;
-#endif
 }
 
 
@@ -2262,7 +2233,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
         }
         default: return HIWONDER_RRC_E_UNKNOWN;
         }
-    case HIWONDER_RRC_RESPONSE:
+    default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 4L: {
             if (n <= 1u) { return HIWONDER_RRC_E_LENGTH; }
@@ -2308,8 +2279,6 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
         }
         default: return HIWONDER_RRC_E_UNKNOWN;
         }
-    default:
-        return HIWONDER_RRC_E_ARG;
     }
 }
 
@@ -2329,9 +2298,6 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
         return HIWONDER_RRC_E_ARG;
     }
     count = hiwonder_rrc__count(dir);
-    if (count == 0u) {
-        return HIWONDER_RRC_E_ARG;
-    }
     k = 0u;
     if (!HIWONDER_RRC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

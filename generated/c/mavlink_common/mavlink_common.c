@@ -23,6 +23,7 @@ typedef char mavlink_common__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MAVLINK_COMMON__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MAVLINK_COMMON__STUFFED 0 /* some layout has byte stuffing */
 #define MAVLINK_COMMON__LENGTHS 1 /* every layout has a length element */
+#define MAVLINK_COMMON__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MAVLINK_COMMON__SINGLE 0 /* one layout per direction */
 #define MAVLINK_COMMON__TABLES (MAVLINK_COMMON_ENABLE_ENCODE || MAVLINK_COMMON__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MAVLINK_COMMON_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -105,10 +106,8 @@ uint16_t mavlink_common_crc_16_mcrf4xx_seeded(uint16_t acc, const uint8_t *data,
 static uint32_t mavlink_common__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(mavlink_common_crc_16_mcrf4xx_seeded(0xffffu, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -127,6 +126,7 @@ static uint32_t mavlink_common__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MAVLINK_COMMON__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MAVLINK_COMMON_ENABLE_DECODE || MAVLINK_COMMON__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int mavlink_common__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -138,6 +138,7 @@ static int mavlink_common__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MAVLINK_COMMON__T(L) (MAVLINK_COMMON__STUFFED && (L)->has_t)
@@ -240,7 +241,7 @@ static int mavlink_common__inner_last(const mavlink_common__layout_t *L)
 }
 #endif
 
-#if MAVLINK_COMMON_ENABLE_ENCODE || MAVLINK_COMMON__STUFFED
+#if MAVLINK_COMMON__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int mavlink_common__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -353,6 +354,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
     int last = mavlink_common__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MAVLINK_COMMON__STUFFED
     if (MAVLINK_COMMON__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -388,10 +390,12 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const mavlink_common__element_t *e = &L->e[k];
+#if MAVLINK_COMMON__STUFFED
         if (MAVLINK_COMMON__T(L) && k == L->t_first) {
             size_t made;
             if (!mavlink_common__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -410,6 +414,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MAVLINK_COMMON__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MAVLINK_COMMON_E_BUFFER;
@@ -432,6 +437,7 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const mavlink_common__element_t *e = &L->e[k];
@@ -569,7 +575,9 @@ static int mavlink_common__unwrap(const mavlink_common__layout_t *L, const uint8
 
 #if MAVLINK_COMMON_ENABLE_PARSER && MAVLINK_COMMON__STUFFED
 static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MAVLINK_COMMON__SIZED
 static long mavlink_common__content_size(mavlink_common_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MAVLINK_COMMON__WAIT for more bytes, MAVLINK_COMMON__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -646,6 +654,7 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
         }
         return MAVLINK_COMMON__WAIT;
     }
+#if MAVLINK_COMMON__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = mavlink_common__content_size(dir, code, b + before, avail - before);
@@ -657,6 +666,9 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
         }
         return (long)L->overhead + size;
     }
+#else
+    return MAVLINK_COMMON__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -860,7 +872,7 @@ static int mavlink_common__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if MAVLINK_COMMON_ENABLE_PARSER && (MAVLINK_COMMON__STUFFED || !MAVLINK_COMMON__LENGTHS)
+#if MAVLINK_COMMON_ENABLE_PARSER && MAVLINK_COMMON__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long mavlink_common__content_size(mavlink_common_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -883,7 +895,7 @@ static long mavlink_common__content_size(mavlink_common_direction_t dir, long co
         default:
             return MAVLINK_COMMON__NONE;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L:
             size = 9L;
@@ -906,8 +918,6 @@ static long mavlink_common__content_size(mavlink_common_direction_t dir, long co
         default:
             return MAVLINK_COMMON__NONE;
         }
-    default:
-        return MAVLINK_COMMON__NONE;
     }
 }
 #endif
@@ -924,7 +934,7 @@ static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, siz
         case 76L: *low = 1u; *high = 33u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L: *low = 1u; *high = 9u; *bounded = 1; return 1;
         case 1L: *low = 1u; *high = 43u; *bounded = 1; return 1;
@@ -934,8 +944,6 @@ static int mavlink_common__bounds(mavlink_common_direction_t dir, long code, siz
         case 77L: *low = 1u; *high = 10u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -1065,37 +1073,17 @@ static long mavlink_common__probe_at(mavlink_common_direction_t dir, uint8_t k, 
         switch (k) {
         case 0u:
             return mavlink_common__probe_request_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__probe_request_1(b, avail);
-        default:
-            break;
         }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (k) {
         case 0u:
             return mavlink_common__probe_response_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__probe_response_1(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if MAVLINK_COMMON__STUFFED
-    {
-        uint8_t count;
-        const mavlink_common__layout_t *const *layouts = mavlink_common__layouts(dir, &count);
-        return k < count ? mavlink_common__probe(layouts[k], dir, b, avail) : MAVLINK_COMMON__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return MAVLINK_COMMON__NONE;
-#endif
 }
 #endif
 
@@ -1112,46 +1100,25 @@ static uint8_t mavlink_common__count(mavlink_common_direction_t dir)
     switch (dir) {
     case MAVLINK_COMMON_REQUEST:
         return 2u;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         return 2u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *mavlink_common__header(mavlink_common_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MAVLINK_COMMON_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return mavlink_common__h_request_0;
-        case 1u:
-            *len = 1u;
-            return mavlink_common__h_request_1;
-        default:
-            break;
-        }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return mavlink_common__h_response_0;
-        case 1u:
-            *len = 1u;
-            return mavlink_common__h_response_1;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {mavlink_common__h_request_0, mavlink_common__h_request_1};
+    static const uint8_t requests_len[] = {1u, 1u};
+    static const uint8_t *const responses[] = {mavlink_common__h_response_0, mavlink_common__h_response_1};
+    static const uint8_t responses_len[] = {1u, 1u};
+    if (dir == MAVLINK_COMMON_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1160,10 +1127,8 @@ static int mavlink_common__has_command(mavlink_common_direction_t dir, uint8_t k
     switch (dir) {
     case MAVLINK_COMMON_REQUEST:
         return ((3UL >> k) & 1u) != 0u;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         return ((3UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1278,37 +1243,17 @@ static int mavlink_common__unwrap_at(mavlink_common_direction_t dir, uint8_t k, 
         switch (k) {
         case 0u:
             return mavlink_common__unwrap_request_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__unwrap_request_1(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (k) {
         case 0u:
             return mavlink_common__unwrap_response_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return mavlink_common__unwrap_response_1(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if MAVLINK_COMMON__STUFFED
-    {
-        uint8_t count;
-        const mavlink_common__layout_t *const *layouts = mavlink_common__layouts(dir, &count);
-        if (k < count) {
-            return mavlink_common__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return MAVLINK_COMMON_E_ARG;
-#else
-    return MAVLINK_COMMON_E_ARG;
-#endif
 }
 
 
@@ -1878,7 +1823,7 @@ static int mavlink_common__decode_content(mavlink_common_direction_t dir, long c
         }
         default: return MAVLINK_COMMON_E_UNKNOWN;
         }
-    case MAVLINK_COMMON_RESPONSE:
+    default: /* MAVLINK_COMMON_RESPONSE */
         switch (code) {
         case 0L: {
             out->kind = MAVLINK_COMMON_HEARTBEAT_RESPONSE; r = mavlink_common__dec_heartbeat_response(c, n, &out->u.heartbeat_response); out->u.heartbeat_response.seq = (uint8_t)values[0]; out->u.heartbeat_response.sysid = (uint8_t)values[1]; out->u.heartbeat_response.compid = (uint8_t)values[2]; mavlink_common__extra(&out->u.heartbeat_response.has_signature, out->u.heartbeat_response.signature, extras[0], 13u); return r;
@@ -1900,8 +1845,6 @@ static int mavlink_common__decode_content(mavlink_common_direction_t dir, long c
         }
         default: return MAVLINK_COMMON_E_UNKNOWN;
         }
-    default:
-        return MAVLINK_COMMON_E_ARG;
     }
 }
 
@@ -1922,9 +1865,6 @@ int mavlink_common_decode_expect(const uint8_t *frame, size_t len, mavlink_commo
         return MAVLINK_COMMON_E_ARG;
     }
     count = mavlink_common__count(dir);
-    if (count == 0u) {
-        return MAVLINK_COMMON_E_ARG;
-    }
     k = 0u;
     if (!MAVLINK_COMMON__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

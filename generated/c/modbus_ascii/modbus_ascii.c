@@ -23,6 +23,7 @@ typedef char modbus_ascii__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_ASCII__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MODBUS_ASCII__STUFFED 1 /* some layout has byte stuffing */
 #define MODBUS_ASCII__LENGTHS 0 /* every layout has a length element */
+#define MODBUS_ASCII__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MODBUS_ASCII__SINGLE 1 /* one layout per direction */
 #define MODBUS_ASCII__TABLES (MODBUS_ASCII_ENABLE_ENCODE || MODBUS_ASCII__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MODBUS_ASCII_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -55,10 +56,8 @@ uint8_t modbus_ascii_sum8(uint8_t acc, const uint8_t *data, size_t n)
 static uint32_t modbus_ascii__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (-(uint32_t)(modbus_ascii_sum8(0u, d, n)) & 0xffu);
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -77,6 +76,7 @@ static uint32_t modbus_ascii__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MODBUS_ASCII__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MODBUS_ASCII_ENABLE_DECODE || MODBUS_ASCII__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_ascii__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -88,6 +88,7 @@ static int modbus_ascii__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MODBUS_ASCII__T(L) (MODBUS_ASCII__STUFFED && (L)->has_t)
@@ -190,7 +191,7 @@ static int modbus_ascii__inner_last(const modbus_ascii__layout_t *L)
 }
 #endif
 
-#if MODBUS_ASCII_ENABLE_ENCODE || MODBUS_ASCII__STUFFED
+#if MODBUS_ASCII__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The value of a hex digit of either case; 16 for a byte that is none. */
 static uint8_t modbus_ascii__hex_ascii_value(uint8_t c)
 {
@@ -365,6 +366,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
     int last = modbus_ascii__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MODBUS_ASCII__STUFFED
     if (MODBUS_ASCII__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -400,10 +402,12 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_ascii__element_t *e = &L->e[k];
+#if MODBUS_ASCII__STUFFED
         if (MODBUS_ASCII__T(L) && k == L->t_first) {
             size_t made;
             if (!modbus_ascii__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -422,6 +426,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MODBUS_ASCII__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MODBUS_ASCII_E_BUFFER;
@@ -444,6 +449,7 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_ascii__element_t *e = &L->e[k];
@@ -581,7 +587,9 @@ static int modbus_ascii__unwrap(const modbus_ascii__layout_t *L, const uint8_t *
 
 #if MODBUS_ASCII_ENABLE_PARSER && MODBUS_ASCII__STUFFED
 static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MODBUS_ASCII__SIZED
 static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MODBUS_ASCII__WAIT for more bytes, MODBUS_ASCII__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -658,6 +666,7 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
         }
         return MODBUS_ASCII__WAIT;
     }
+#if MODBUS_ASCII__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = modbus_ascii__content_size(dir, code, b + before, avail - before);
@@ -669,6 +678,9 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
         }
         return (long)L->overhead + size;
     }
+#else
+    return MODBUS_ASCII__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -738,7 +750,7 @@ static void modbus_ascii__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if MODBUS_ASCII_ENABLE_PARSER && (MODBUS_ASCII__STUFFED || !MODBUS_ASCII__LENGTHS)
+#if MODBUS_ASCII_ENABLE_PARSER && MODBUS_ASCII__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -788,7 +800,7 @@ static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, 
         default:
             return MODBUS_ASCII__NONE;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -836,8 +848,6 @@ static long modbus_ascii__content_size(modbus_ascii_direction_t dir, long code, 
         default:
             return MODBUS_ASCII__NONE;
         }
-    default:
-        return MODBUS_ASCII__NONE;
     }
 }
 #endif
@@ -861,7 +871,7 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
         case 23L: *low = 9u; *high = 251u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 256u; *bounded = 1; return 1;
         case 2L: *low = 1u; *high = 256u; *bounded = 1; return 1;
@@ -876,8 +886,6 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
         case MODBUS_ASCII__ERROR_CODE: *low = 1u; *high = 1u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -888,7 +896,6 @@ static int modbus_ascii__bounds(modbus_ascii_direction_t dir, long code, size_t 
 static long modbus_ascii__probe_at(modbus_ascii_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
 {
     switch (dir) {
-
     default:
         break;
     }
@@ -918,40 +925,25 @@ static uint8_t modbus_ascii__count(modbus_ascii_direction_t dir)
     switch (dir) {
     case MODBUS_ASCII_REQUEST:
         return 1u;
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *modbus_ascii__header(modbus_ascii_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MODBUS_ASCII_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return modbus_ascii__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case MODBUS_ASCII_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return modbus_ascii__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {modbus_ascii__h_request_0};
+    static const uint8_t requests_len[] = {1u};
+    static const uint8_t *const responses[] = {modbus_ascii__h_response_0};
+    static const uint8_t responses_len[] = {1u};
+    if (dir == MODBUS_ASCII_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -960,10 +952,8 @@ static int modbus_ascii__has_command(modbus_ascii_direction_t dir, uint8_t k)
     switch (dir) {
     case MODBUS_ASCII_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -975,7 +965,6 @@ static int modbus_ascii__unwrap_at(modbus_ascii_direction_t dir, uint8_t k, cons
     (void)k;
     (void)plain;
     switch (dir) {
-
     default:
         break;
     }
@@ -1554,7 +1543,7 @@ static int modbus_ascii__decode_content(modbus_ascii_direction_t dir, long code,
         }
         default: return MODBUS_ASCII_E_UNKNOWN;
         }
-    case MODBUS_ASCII_RESPONSE:
+    default: /* MODBUS_ASCII_RESPONSE */
         if (code >= 0 && ((unsigned long)code & 128UL) != 0u) {
             out->u.exception_response.function = (uint8_t)((unsigned long)code & 127UL);
             out->kind = MODBUS_ASCII_EXCEPTION_RESPONSE; r = modbus_ascii__dec_exception_response(c, n, &out->u.exception_response); out->u.exception_response.unit = (uint8_t)values[0]; return r;
@@ -1592,8 +1581,6 @@ static int modbus_ascii__decode_content(modbus_ascii_direction_t dir, long code,
         }
         default: return MODBUS_ASCII_E_UNKNOWN;
         }
-    default:
-        return MODBUS_ASCII_E_ARG;
     }
 }
 
@@ -1613,9 +1600,6 @@ int modbus_ascii_decode_expect(const uint8_t *frame, size_t len, modbus_ascii_di
         return MODBUS_ASCII_E_ARG;
     }
     count = modbus_ascii__count(dir);
-    if (count == 0u) {
-        return MODBUS_ASCII_E_ARG;
-    }
     k = 0u;
     if (!MODBUS_ASCII__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -23,6 +23,7 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_RTU__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MODBUS_RTU__STUFFED 0 /* some layout has byte stuffing */
 #define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
+#define MODBUS_RTU__SIZED 1 /* some layout's size follows from its content's leading fields (a size rule) */
 #define MODBUS_RTU__SINGLE 1 /* one layout per direction */
 #define MODBUS_RTU__TABLES (MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (MODBUS_RTU_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -59,10 +60,8 @@ uint16_t modbus_rtu_crc_16_modbus(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(modbus_rtu_crc_16_modbus(0xffffu, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +80,7 @@ static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!MODBUS_RTU__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if MODBUS_RTU_ENABLE_DECODE || MODBUS_RTU__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +92,7 @@ static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MODBUS_RTU__T(L) (MODBUS_RTU__STUFFED && (L)->has_t)
@@ -194,7 +195,7 @@ static int modbus_rtu__inner_last(const modbus_rtu__layout_t *L)
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
+#if MODBUS_RTU__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int modbus_rtu__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +308,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     int last = modbus_rtu__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if MODBUS_RTU__STUFFED
     if (MODBUS_RTU__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +344,12 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
+#if MODBUS_RTU__STUFFED
         if (MODBUS_RTU__T(L) && k == L->t_first) {
             size_t made;
             if (!modbus_rtu__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +368,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == MODBUS_RTU__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return MODBUS_RTU_E_BUFFER;
@@ -386,6 +391,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
@@ -523,7 +529,9 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
 
 #if MODBUS_RTU_ENABLE_PARSER && MODBUS_RTU__STUFFED
 static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if MODBUS_RTU__SIZED
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): MODBUS_RTU__WAIT for more bytes, MODBUS_RTU__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -600,6 +608,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         }
         return MODBUS_RTU__WAIT;
     }
+#if MODBUS_RTU__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = modbus_rtu__content_size(dir, code, b + before, avail - before);
@@ -611,6 +620,9 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         }
         return (long)L->overhead + size;
     }
+#else
+    return MODBUS_RTU__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -670,7 +682,7 @@ static void modbus_rtu__copy(void *dst, const uint8_t *src, size_t n)
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_PARSER && (MODBUS_RTU__STUFFED || !MODBUS_RTU__LENGTHS)
+#if MODBUS_RTU_ENABLE_PARSER && MODBUS_RTU__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -720,7 +732,7 @@ static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, cons
         default:
             return MODBUS_RTU__NONE;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (code) {
         case 1L:
             size = 1L;
@@ -768,8 +780,6 @@ static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, cons
         default:
             return MODBUS_RTU__NONE;
         }
-    default:
-        return MODBUS_RTU__NONE;
     }
 }
 #endif
@@ -793,7 +803,7 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
         case 23L: *low = 9u; *high = 251u; *bounded = 1; return 1;
         default: return 0;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (code) {
         case 1L: *low = 1u; *high = 256u; *bounded = 1; return 1;
         case 2L: *low = 1u; *high = 256u; *bounded = 1; return 1;
@@ -808,8 +818,6 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
         case MODBUS_RTU__ERROR_CODE: *low = 1u; *high = 1u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -857,35 +865,15 @@ static long modbus_rtu__probe_at(modbus_rtu_direction_t dir, uint8_t k, const ui
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if MODBUS_RTU__STUFFED
-    {
-        uint8_t count;
-        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
-        return k < count ? modbus_rtu__probe(layouts[k], dir, b, avail) : MODBUS_RTU__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return MODBUS_RTU__NONE;
-#endif
 }
 #endif
 
@@ -899,34 +887,25 @@ static uint8_t modbus_rtu__count(modbus_rtu_direction_t dir)
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         return 1u;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *modbus_rtu__header(modbus_rtu_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case MODBUS_RTU_REQUEST:
-        switch (k) {
-        default:
-            break;
-        }
-        break;
-    case MODBUS_RTU_RESPONSE:
-        switch (k) {
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {NULL};
+    static const uint8_t requests_len[] = {0u};
+    static const uint8_t *const responses[] = {NULL};
+    static const uint8_t responses_len[] = {0u};
+    if (dir == MODBUS_RTU_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -935,10 +914,8 @@ static int modbus_rtu__has_command(modbus_rtu_direction_t dir, uint8_t k)
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -987,35 +964,15 @@ static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const ui
     switch (dir) {
     case MODBUS_RTU_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return modbus_rtu__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if MODBUS_RTU__STUFFED
-    {
-        uint8_t count;
-        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
-        if (k < count) {
-            return modbus_rtu__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return MODBUS_RTU_E_ARG;
-#else
-    return MODBUS_RTU_E_ARG;
-#endif
 }
 
 
@@ -1579,7 +1536,7 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
         }
         default: return MODBUS_RTU_E_UNKNOWN;
         }
-    case MODBUS_RTU_RESPONSE:
+    default: /* MODBUS_RTU_RESPONSE */
         if (code >= 0 && ((unsigned long)code & 128UL) != 0u) {
             out->u.exception_response.function = (uint8_t)((unsigned long)code & 127UL);
             out->kind = MODBUS_RTU_EXCEPTION_RESPONSE; r = modbus_rtu__dec_exception_response(c, n, &out->u.exception_response); out->u.exception_response.unit = (uint8_t)values[0]; return r;
@@ -1617,8 +1574,6 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
         }
         default: return MODBUS_RTU_E_UNKNOWN;
         }
-    default:
-        return MODBUS_RTU_E_ARG;
     }
 }
 
@@ -1638,9 +1593,6 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
         return MODBUS_RTU_E_ARG;
     }
     count = modbus_rtu__count(dir);
-    if (count == 0u) {
-        return MODBUS_RTU_E_ARG;
-    }
     k = 0u;
     if (!MODBUS_RTU__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

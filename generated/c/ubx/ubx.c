@@ -23,6 +23,7 @@ typedef char ubx__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define UBX__KEEP 1u      /* bytes kept at the end that could begin a header */
 #define UBX__STUFFED 0 /* some layout has byte stuffing */
 #define UBX__LENGTHS 1 /* every layout has a length element */
+#define UBX__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define UBX__SINGLE 1 /* one layout per direction */
 #define UBX__TABLES (UBX_ENABLE_ENCODE || UBX__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (UBX_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -57,10 +58,8 @@ uint16_t ubx_fletcher256(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t ubx__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(ubx_fletcher256(0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -79,6 +78,7 @@ static uint32_t ubx__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!UBX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if UBX_ENABLE_DECODE || UBX__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int ubx__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -90,6 +90,7 @@ static int ubx__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define UBX__T(L) (UBX__STUFFED && (L)->has_t)
@@ -192,7 +193,7 @@ static int ubx__inner_last(const ubx__layout_t *L)
 }
 #endif
 
-#if UBX_ENABLE_ENCODE || UBX__STUFFED
+#if UBX__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int ubx__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -305,6 +306,7 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     int last = ubx__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if UBX__STUFFED
     if (UBX__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -340,10 +342,12 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const ubx__element_t *e = &L->e[k];
+#if UBX__STUFFED
         if (UBX__T(L) && k == L->t_first) {
             size_t made;
             if (!ubx__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -362,6 +366,7 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == UBX__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return UBX_E_BUFFER;
@@ -384,6 +389,7 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const ubx__element_t *e = &L->e[k];
@@ -521,7 +527,9 @@ static int ubx__unwrap(const ubx__layout_t *L, const uint8_t *frame, size_t n, u
 
 #if UBX_ENABLE_PARSER && UBX__STUFFED
 static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if UBX__SIZED
 static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): UBX__WAIT for more bytes, UBX__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -598,6 +606,7 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
         }
         return UBX__WAIT;
     }
+#if UBX__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = ubx__content_size(dir, code, b + before, avail - before);
@@ -609,6 +618,9 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
         }
         return (long)L->overhead + size;
     }
+#else
+    return UBX__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -738,7 +750,7 @@ static int ubx__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if UBX_ENABLE_PARSER && (UBX__STUFFED || !UBX__LENGTHS)
+#if UBX_ENABLE_PARSER && UBX__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -761,7 +773,7 @@ static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, 
         default:
             return UBX__NONE;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L:
             size = 16L;
@@ -781,8 +793,6 @@ static long ubx__content_size(ubx_direction_t dir, long code, const uint8_t *c, 
         default:
             return UBX__NONE;
         }
-    default:
-        return UBX__NONE;
     }
 }
 #endif
@@ -802,7 +812,7 @@ static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high
         case 2564L: *low = 0u; *high = 0u; *bounded = 1; return 1;
         default: return 0;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L: *low = 16u; *high = 16u; *bounded = 1; return 1;
         case 263L: *low = 92u; *high = 92u; *bounded = 1; return 1;
@@ -813,8 +823,6 @@ static int ubx__bounds(ubx_direction_t dir, long code, size_t *low, size_t *high
         case 2564L: *low = 40u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -866,35 +874,15 @@ static long ubx__probe_at(ubx_direction_t dir, uint8_t k, const uint8_t *b, size
     switch (dir) {
     case UBX_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__probe_request_0(b, avail);
-        default:
-            break;
         }
-        break;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__probe_response_0(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if UBX__STUFFED
-    {
-        uint8_t count;
-        const ubx__layout_t *const *layouts = ubx__layouts(dir, &count);
-        return k < count ? ubx__probe(layouts[k], dir, b, avail) : UBX__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return UBX__NONE;
-#endif
 }
 #endif
 
@@ -909,40 +897,25 @@ static uint8_t ubx__count(ubx_direction_t dir)
     switch (dir) {
     case UBX_REQUEST:
         return 1u;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         return 1u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *ubx__header(ubx_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case UBX_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return ubx__h_request_0;
-        default:
-            break;
-        }
-        break;
-    case UBX_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 2u;
-            return ubx__h_response_0;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {ubx__h_request_0};
+    static const uint8_t requests_len[] = {2u};
+    static const uint8_t *const responses[] = {ubx__h_response_0};
+    static const uint8_t responses_len[] = {2u};
+    if (dir == UBX_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -951,10 +924,8 @@ static int ubx__has_command(ubx_direction_t dir, uint8_t k)
     switch (dir) {
     case UBX_REQUEST:
         return ((1UL >> k) & 1u) != 0u;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         return ((1UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1005,35 +976,15 @@ static int ubx__unwrap_at(ubx_direction_t dir, uint8_t k, const uint8_t *frame, 
     switch (dir) {
     case UBX_REQUEST:
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__unwrap_request_0(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (k) {
-        case 0u:
+        default: /* 0u */
             return ubx__unwrap_response_0(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if UBX__STUFFED
-    {
-        uint8_t count;
-        const ubx__layout_t *const *layouts = ubx__layouts(dir, &count);
-        if (k < count) {
-            return ubx__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return UBX_E_ARG;
-#else
-    return UBX_E_ARG;
-#endif
 }
 
 
@@ -1522,7 +1473,7 @@ static int ubx__decode_content(ubx_direction_t dir, long code, ubx_kind_t expect
         }
         default: return UBX_E_UNKNOWN;
         }
-    case UBX_RESPONSE:
+    default: /* UBX_RESPONSE */
         switch (code) {
         case 259L: {
             out->kind = UBX_NAV_STATUS_RESPONSE; r = ubx__dec_nav_status_response(c, n, &out->u.nav_status_response);  return r;
@@ -1547,8 +1498,6 @@ static int ubx__decode_content(ubx_direction_t dir, long code, ubx_kind_t expect
         }
         default: return UBX_E_UNKNOWN;
         }
-    default:
-        return UBX_E_ARG;
     }
 }
 
@@ -1568,9 +1517,6 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
         return UBX_E_ARG;
     }
     count = ubx__count(dir);
-    if (count == 0u) {
-        return UBX_E_ARG;
-    }
     k = 0u;
     if (!UBX__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

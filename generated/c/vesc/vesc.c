@@ -23,6 +23,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define VESC__STUFFED 0 /* some layout has byte stuffing */
 #define VESC__LENGTHS 1 /* every layout has a length element */
+#define VESC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define VESC__SINGLE 0 /* one layout per direction */
 #define VESC__TABLES (VESC_ENABLE_ENCODE || VESC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (VESC_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -59,10 +60,8 @@ uint16_t vesc_crc_16_xmodem(uint16_t acc, const uint8_t *data, size_t n)
 static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
 {
     switch (which) {
-    case 0u:
+    default: /* 0u */
         return (uint32_t)(vesc_crc_16_xmodem(0x0u, d, n));
-    default:
-        return 0u;
     }
 }
 /* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
@@ -81,6 +80,7 @@ static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!VESC__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if VESC_ENABLE_DECODE || VESC__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -92,6 +92,7 @@ static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define VESC__T(L) (VESC__STUFFED && (L)->has_t)
@@ -194,7 +195,7 @@ static int vesc__inner_last(const vesc__layout_t *L)
 }
 #endif
 
-#if VESC_ENABLE_ENCODE || VESC__STUFFED
+#if VESC__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int vesc__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -307,6 +308,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     int last = vesc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if VESC__STUFFED
     if (VESC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -342,10 +344,12 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
+#if VESC__STUFFED
         if (VESC__T(L) && k == L->t_first) {
             size_t made;
             if (!vesc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -364,6 +368,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == VESC__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return VESC_E_BUFFER;
@@ -386,6 +391,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
@@ -523,7 +529,9 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
 
 #if VESC_ENABLE_PARSER && VESC__STUFFED
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if VESC__SIZED
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): VESC__WAIT for more bytes, VESC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -600,6 +608,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         }
         return VESC__WAIT;
     }
+#if VESC__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = vesc__content_size(dir, code, b + before, avail - before);
@@ -611,6 +620,9 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         }
         return (long)L->overhead + size;
     }
+#else
+    return VESC__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 
@@ -770,7 +782,7 @@ static int vesc__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if VESC_ENABLE_PARSER && (VESC__STUFFED || !VESC__LENGTHS)
+#if VESC_ENABLE_PARSER && VESC__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -811,7 +823,7 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
         default:
             return VESC__NONE;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 4L:
             size = 73L;
@@ -822,8 +834,6 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
         default:
             return VESC__NONE;
         }
-    default:
-        return VESC__NONE;
     }
 }
 #endif
@@ -847,7 +857,7 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
         case 34L: *low = 1u; *high = 0u; *bounded = 0; return 1;
         default: return 0;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 0L: *low = 28u; *high = 0u; *bounded = 0; return 1;
         case 4L: *low = 73u; *high = 73u; *bounded = 1; return 1;
@@ -855,8 +865,6 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
         case 22L: *low = 4u; *high = 4u; *bounded = 1; return 1;
         default: return 0;
         }
-    default:
-        return 0;
     }
 }
 
@@ -946,37 +954,17 @@ static long vesc__probe_at(vesc_direction_t dir, uint8_t k, const uint8_t *b, si
         switch (k) {
         case 0u:
             return vesc__probe_request_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return vesc__probe_request_1(b, avail);
-        default:
-            break;
         }
-        break;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (k) {
         case 0u:
             return vesc__probe_response_0(b, avail);
-        case 1u:
+        default: /* 1u */
             return vesc__probe_response_1(b, avail);
-        default:
-            break;
         }
-        break;
-    default:
-        break;
     }
-#if VESC__STUFFED
-    {
-        uint8_t count;
-        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
-        return k < count ? vesc__probe(layouts[k], dir, b, avail) : VESC__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return VESC__NONE;
-#endif
 }
 #endif
 
@@ -993,46 +981,25 @@ static uint8_t vesc__count(vesc_direction_t dir)
     switch (dir) {
     case VESC_REQUEST:
         return 2u;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         return 2u;
-    default:
-        return 0u;
     }
 }
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *vesc__header(vesc_direction_t dir, uint8_t k, size_t *len)
 {
-    switch (dir) {
-    case VESC_REQUEST:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return vesc__h_request_0;
-        case 1u:
-            *len = 1u;
-            return vesc__h_request_1;
-        default:
-            break;
-        }
-        break;
-    case VESC_RESPONSE:
-        switch (k) {
-        case 0u:
-            *len = 1u;
-            return vesc__h_response_0;
-        case 1u:
-            *len = 1u;
-            return vesc__h_response_1;
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
+    static const uint8_t *const requests[] = {vesc__h_request_0, vesc__h_request_1};
+    static const uint8_t requests_len[] = {1u, 1u};
+    static const uint8_t *const responses[] = {vesc__h_response_0, vesc__h_response_1};
+    static const uint8_t responses_len[] = {1u, 1u};
+    if (dir == VESC_REQUEST) {
+        *len = requests_len[k];
+        return requests[k];
     }
-    *len = 0u;
-    return NULL;
+    *len = responses_len[k];
+    return responses[k];
 }
 
 /* 1 when the direction's layout k carries a command code. */
@@ -1041,10 +1008,8 @@ static int vesc__has_command(vesc_direction_t dir, uint8_t k)
     switch (dir) {
     case VESC_REQUEST:
         return ((3UL >> k) & 1u) != 0u;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         return ((3UL >> k) & 1u) != 0u;
-    default:
-        return 0;
     }
 }
 
@@ -1135,37 +1100,17 @@ static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const uint8_t *frame
         switch (k) {
         case 0u:
             return vesc__unwrap_request_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return vesc__unwrap_request_1(frame, n, code, values, content, clen);
-        default:
-            break;
         }
-        break;
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (k) {
         case 0u:
             return vesc__unwrap_response_0(frame, n, code, values, content, clen);
-        case 1u:
+        default: /* 1u */
             return vesc__unwrap_response_1(frame, n, code, values, content, clen);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if VESC__STUFFED
-    {
-        uint8_t count;
-        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
-        if (k < count) {
-            return vesc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
         }
     }
-    return VESC_E_ARG;
-#else
-    return VESC_E_ARG;
-#endif
 }
 
 
@@ -1582,7 +1527,7 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
         }
         default: return VESC_E_UNKNOWN;
         }
-    case VESC_RESPONSE:
+    default: /* VESC_RESPONSE */
         switch (code) {
         case 0L: {
             out->kind = VESC_FW_VERSION_RESPONSE; r = vesc__dec_fw_version_response(c, n, &out->u.fw_version_response);  return r;
@@ -1598,8 +1543,6 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
         }
         default: return VESC_E_UNKNOWN;
         }
-    default:
-        return VESC_E_ARG;
     }
 }
 
@@ -1619,9 +1562,6 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
         return VESC_E_ARG;
     }
     count = vesc__count(dir);
-    if (count == 0u) {
-        return VESC_E_ARG;
-    }
     k = 0u;
     if (!VESC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */

@@ -17,6 +17,7 @@ HEAD = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/frami
     ((((value) >= (e)->minimum && (value) <= (e)->maximum) || ((e)->has_also && (value) == (e)->also)) && \
      (!PFX__OPTIONAL || (e)->first == 0u || (((value) >> ((e)->first - 1u)) & 1u) == (e)->last))
 
+#if PFX_ENABLE_DECODE || PFX__STUFFED
 /* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
 static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
 {
@@ -28,6 +29,7 @@ static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
     }
     return 1;
 }
+#endif
 
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define PFX__T(L) (PFX__STUFFED && (L)->has_t)
@@ -136,7 +138,7 @@ static int pfx__inner_last(const pfx__layout_t *L)
 }
 #endif
 
-#if PFX_ENABLE_ENCODE || PFX__STUFFED
+#if PFX__STUFFED /* no layout stuffed: the rewriting code is left out (it would be compiled and never run) */
 /* ---- transforms ---- */
 
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
@@ -223,6 +225,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+#if PFX__STUFFED
     if (PFX__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
@@ -258,10 +261,12 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             }
         }
     }
+#endif
     /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
+#if PFX__STUFFED
         if (PFX__T(L) && k == L->t_first) {
             size_t made;
             if (!pfx__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
@@ -280,6 +285,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             k = L->t_last;
             continue;
         }
+#endif
         sz = e->role == PFX__ROLE_CONTENT ? clen : e->size;
         if (sz > cap - pos) {
             return PFX_E_BUFFER;
@@ -302,6 +308,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     (void)first;
     (void)last;
     (void)extras;
+    (void)i;
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
@@ -439,7 +446,9 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
 
 #if PFX_ENABLE_PARSER && PFX__STUFFED
 static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+#if PFX__SIZED
 static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, size_t avail);
+#endif
 
 /* The size of a plausible frame of layout L at b[0..avail): PFX__WAIT for more bytes, PFX__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -516,6 +525,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         }
         return PFX__WAIT;
     }
+#if PFX__SIZED
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
         long size = pfx__content_size(dir, code, b + before, avail - before);
@@ -527,6 +537,9 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         }
         return (long)L->overhead + size;
     }
+#else
+    return PFX__NONE; /* no layout sized by its content: each one without a length ended at its trailer above */
+#endif
 }
 #endif
 """

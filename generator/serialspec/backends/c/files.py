@@ -678,10 +678,13 @@ def source(ctx: Ctx) -> str:
     probe_cases: list[str] = []
     header_arrays: list[str] = []
     header_cases: list[str] = []
+    header_returns: list[str] = []
     command_cases: list[str] = []
     count_cases: list[str] = []
     least_cases: list[str] = []
     waits = False  # the classic parser waits for a prefix in some direction
+    both = len(directions(protocol)) == len(DIRECTIONS)  # every direction the API lets through has its cases
+    probed = unwrapped = both  # every layout's case there: nothing after the switch is reached
     for d in directions(protocol):
         alternatives = protocol.framing.alternatives[d]
         fewest = min(_prefix(ctx, a) for a in alternatives)
@@ -690,28 +693,31 @@ def source(ctx: Ctx) -> str:
         count_cases.append(f"    case {P}_{d.name}:\n        return {len(alternatives)}u;")
         mask = sum(1 << k for k, layout in enumerate(alternatives) if layout.has_command)
         command_cases.append(f"    case {P}_{d.name}:\n        return (({mask}UL >> k) & 1u) != 0u;")
-        hrows, prows = [], []
+        prows = []
         for k, layout in enumerate(alternatives):
             if layout.header:
                 hname = f"{p}__h_{d.value}_{k}"
                 header_arrays.append(
                     f"static const uint8_t {hname}[] = {{{', '.join(f'0x{b:02x}u' for b in layout.header)}}};"
                 )
-                size = len(layout.header)
-                hrows.append(f"        case {k}u:\n            *len = {size}u;\n            return {hname};")
             if layout.transparency is None:
                 probes.append(straight_probe(ctx, d, k, layout))
                 prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail);")
+        # each direction's headers as a table by layout (NULL, 0: none); k is below the direction's count
+        heads = [f"{p}__h_{d.value}_{k}" if layout.header else "NULL" for k, layout in enumerate(alternatives)]
+        sizes = [f"{len(layout.header)}u" for layout in alternatives]
         header_cases.append(
-            f"    case {P}_{d.name}:\n        switch (k) {{\n"
-            + "".join(row + "\n" for row in hrows)
-            + "        default:\n            break;\n        }\n        break;"
+            f"    static const uint8_t *const {d.value}s[] = {{{', '.join(heads)}}};\n"
+            f"    static const uint8_t {d.value}s_len[] = {{{', '.join(sizes)}}};"
         )
+        header_returns.append(f"*len = {d.value}s_len[k];\n        return {d.value}s[k];")
+        every_k = len(prows) == len(alternatives)
+        probed = probed and every_k
         if prows:
             probe_cases.append(
                 f"    case {P}_{d.name}:\n        switch (k) {{\n"
-                + "\n".join(prows)
-                + "\n        default:\n            break;\n        }\n        break;"
+                + switch_cases(prows, every_k, "        default:\n            break;")
+                + ("\n        }" if every_k else "\n        }\n        break;")
             )
         rows = []
         for k, layout in enumerate(alternatives):
@@ -722,18 +728,20 @@ def source(ctx: Ctx) -> str:
                     f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen"
                     + (", 0);" if length_byte.applies(protocol) else ");")
                 )
+        every_k = len(rows) == len(alternatives)
+        unwrapped = unwrapped and every_k
         if rows:
             unwrap_cases.append(
                 f"    case {P}_{d.name}:\n        switch (k) {{\n"
-                + "\n".join(rows)
-                + "\n        default:\n            break;\n        }\n        break;"
+                + switch_cases(rows, every_k, "        default:\n            break;")
+                + ("\n        }" if every_k else "\n        }\n        break;")
             )
     # checksums
     check_defs = "\n".join(dict.fromkeys(c.definition for _, c in ctx.checks))
-    cases = "\n".join(
+    cases = [
         f"    case {i}u:\n        return {c.finish.format(a=f'{c.name}({c.start}, d, n)')};"
         for i, (_, c) in enumerate(ctx.checks)
-    )
+    ]
     reflect = ""
     if any(c.reflects for _, c in ctx.checks):
         reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
@@ -747,7 +755,7 @@ def source(ctx: Ctx) -> str:
     return r;
 }}
 """
-    size_rules = "\n".join(size_rule_cases(ctx, d) for d in directions(protocol))
+    size_rules = [size_rule_cases(ctx, d) for d in directions(protocol)]
     any_stuffed = any(stuffed.values())
     # __get: read by the engine's code for stuffed layouts and by the content code that asks for it
     engine = HEAD + (GET if any_stuffed or "get" in ctx.helpers else "") + TAIL
@@ -896,10 +904,10 @@ def source(ctx: Ctx) -> str:
     headers = [layout.header for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     has_headers = 1 if all(headers) else 0
     keep = max(0, max((len(h) for h in headers), default=1) - 1)
-    dir_layouts = "\n".join(
+    dir_layouts = [
         f"    case {P}_{d.name}:\n        *count = {n_layouts[d]}u;\n        return {p}__layouts_{d.value};"
         for d in directions(protocol)
-    )
+    ]
     least, least_check = "", ""
     if waits:
         least = f"""
@@ -907,9 +915,7 @@ def source(ctx: Ctx) -> str:
 static size_t {p}__least({p}_direction_t dir)
 {{
     switch (dir) {{
-{chr(10).join(least_cases)}
-    default:
-        return 0u;
+{switch_cases(least_cases, both, "    default:" + chr(10) + "        return 0u;")}
     }}
 }}
 """
@@ -924,7 +930,7 @@ static size_t {p}__least({p}_direction_t dir)
             break;
         }}"""
     # a framing without checksums still has the (empty) dispatch, which never reads its bytes
-    no_checksums = "" if cases.strip() else "\n    (void)d;\n    (void)n;"
+    no_checksums = "" if cases else "\n    (void)d;\n    (void)n;"
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     optionals = max((len(optional.elements_of(ctx, d)) for d in directions(protocol)), default=0)
     xparams = "uint8_t present, const uint8_t *const *extras, " if opt else ""
@@ -941,6 +947,10 @@ static size_t {p}__least({p}_direction_t dir)
     extras_decl = f"\n    const uint8_t *extras[{optionals}];" if opt else ""
     find_extras = "\n    " + f"{p}__extras(dir, k, frame, len, extras);" if opt else ""
     all_lengths = int(all(layout.length is not None for layout in every))
+    # a layout without a length is sized by its content (the probe's size rules) unless stuffed and ended by a
+    # trailer (the engine's probe finds that first)
+    trailed = [bool(layout.transparency) and len(layout.elements) > 1 and layout.elements[-1].fixed for layout in every]
+    sized = any(layout.length is None and not t for layout, t in zip(every, trailed, strict=True))
     single = int(all(n == 1 for n in n_layouts.values()))
     text = f"""{banner(protocol)}
 #include "{p}.h"
@@ -963,6 +973,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__KEEP {keep}u      /* bytes kept at the end that could begin a header */
 #define {P}__STUFFED {int(any_stuffed)} /* some layout has byte stuffing */
 #define {P}__LENGTHS {all_lengths} /* every layout has a length element */
+#define {P}__SIZED {int(sized)} /* some layout's size follows from its content's leading fields (a size rule) */
 #define {P}__SINGLE {single} /* one layout per direction */
 #define {P}__TABLES ({P}_ENABLE_ENCODE || {P}__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes ({P}_ROLE): the other side's is refused before any work, so the compiler leaves
@@ -985,9 +996,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 static uint32_t {p}__check(uint8_t which, const uint8_t *d, size_t n)
 {{{no_checksums}
     switch (which) {{
-{cases}
-    default:
-        return 0u;
+{switch_cases(cases, bool(cases), "    default:" + chr(10) + "        return 0u;")}
     }}
 }}
 {engine}
@@ -1000,17 +1009,14 @@ static uint32_t {p}__check(uint8_t which, const uint8_t *d, size_t n)
 static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *count)
 {{
     switch (dir) {{
-{dir_layouts}
-    default:
-        *count = 0u;
-        return NULL;
+{switch_cases(dir_layouts, False, "    default:" + chr(10) + "        *count = 0u;" + chr(10) + "        return NULL;")}
     }}
 }}
 #endif
 #endif
 
 {helpers}
-#if {P}_ENABLE_PARSER && ({P}__STUFFED || !{P}__LENGTHS)
+#if {P}_ENABLE_PARSER && {P}__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, size_t avail)
 {{
@@ -1019,9 +1025,7 @@ static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, 
     (void)avail;
     (void)size;
     switch (dir) {{
-{size_rules}
-    default:
-        return {P}__NONE;
+{switch_cases(size_rules, both, "    default:" + chr(10) + f"        return {P}__NONE;")}
     }}
 }}
 #endif
@@ -1031,9 +1035,7 @@ static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, 
 static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {{
     switch (dir) {{
-{chr(10).join(bounds_cases)}
-    default:
-        return 0;
+{switch_cases(bounds_cases, both, "    default:" + chr(10) + "        return 0;")}
     }}
 }}
 
@@ -1041,16 +1043,17 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     probing = (
         "/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */\n"
     )
-    probing += f"""{chr(10).join(probes)}
-/* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when
- * none starts there. */
-static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
-{{
-    switch (dir) {{
-{chr(10).join(probe_cases)}
-    default:
-        break;
-    }}
+    no_layouts = f"""
+    if (count == 0u) {{ /* a direction the protocol has no frames for */
+        return {P}_E_ARG;
+    }}"""
+    last = header_returns[-1].replace("\n        ", "\n    ")  # the last direction's (or the one's): no test
+    header_dispatch = (
+        f"if (dir == {P}_{directions(protocol)[0].name}) {{\n        {header_returns[0]}\n    }}\n    {last}"
+        if len(header_returns) == 2
+        else f"(void)dir;\n    {last}"
+    )
+    probe_rest = f"""
 #if {P}__STUFFED
     {{
         uint8_t count;
@@ -1062,7 +1065,28 @@ static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size
     (void)b;
     (void)avail;
     return {P}__NONE;
-#endif
+#endif"""
+    unwrap_rest = f"""
+#if {P}__STUFFED
+    {{
+        uint8_t count;
+        const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
+        if (k < count) {{
+            return {p}__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }}
+    }}
+    return {P}_E_ARG;
+#else
+    return {P}_E_ARG;
+#endif"""
+    probing += f"""{chr(10).join(probes)}
+/* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when
+ * none starts there. */
+static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{{
+    switch (dir) {{
+{switch_cases(probe_cases, probed, "    default:" + chr(10) + "        break;")}
+    }}{"" if probed else probe_rest}
 }}
 """
     middle = f"""#endif
@@ -1075,31 +1099,23 @@ static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size
 static uint8_t {p}__count({p}_direction_t dir)
 {{
     switch (dir) {{
-{chr(10).join(count_cases)}
-    default:
-        return 0u;
+{switch_cases(count_cases, both, "    default:" + chr(10) + "        return 0u;")}
     }}
 }}
 
-/* The leading constant of the direction's layout k (NULL and 0: none). */
+/* The leading constant of the direction's layout k (NULL and 0: none); k is below the direction's count, and a
+ * direction without layouts has none to ask for. */
 static const uint8_t *{p}__header({p}_direction_t dir, uint8_t k, size_t *len)
 {{
-    switch (dir) {{
 {chr(10).join(header_cases)}
-    default:
-        break;
-    }}
-    *len = 0u;
-    return NULL;
+    {header_dispatch}
 }}
 
 /* 1 when the direction's layout k carries a command code. */
 static int {p}__has_command({p}_direction_t dir, uint8_t k)
 {{
     switch (dir) {{
-{chr(10).join(command_cases)}
-    default:
-        return 0;
+{switch_cases(command_cases, both, "    default:" + chr(10) + "        return 0;")}
     }}
 }}
 
@@ -1111,22 +1127,8 @@ static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, 
     (void)k;
     (void)plain;
     switch (dir) {{
-{chr(10).join(unwrap_cases)}
-    default:
-        break;
-    }}
-#if {P}__STUFFED
-    {{
-        uint8_t count;
-        const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
-        if (k < count) {{
-            return {p}__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
-        }}
-    }}
-    return {P}_E_ARG;
-#else
-    return {P}_E_ARG;
-#endif
+{switch_cases(unwrap_cases, unwrapped, "    default:" + chr(10) + "        break;")}
+    }}{"" if unwrapped else unwrap_rest}
 }}
 
 {admits_fn}
@@ -1139,9 +1141,7 @@ static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect
     (void)expect;
     (void)values;
     switch (dir) {{
-{chr(10).join(dec_cases)}
-    default:
-        return {P}_E_ARG;
+{switch_cases(dec_cases, both, "    default:" + chr(10) + f"        return {P}_E_ARG;")}
     }}
 }}
 
@@ -1160,10 +1160,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     if (!{P}__DECODES(dir)) {{ /* the other side's direction, left out of this build */
         return {P}_E_ARG;
     }}
-    count = {p}__count(dir);
-    if (count == 0u) {{
-        return {P}_E_ARG;
-    }}
+    count = {p}__count(dir);{"" if both else no_layouts}
     k = 0u;
     if (!{P}__SINGLE && count != 1u) {{
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
@@ -1604,6 +1601,19 @@ const char *{p}_result_name(int result)
 
 
 ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY
+
+
+def switch_cases(cases: list[str], closed: bool, otherwise: str) -> str:
+    """The cases of a switch, then its default. Where the cases cover every value the callers can pass (`closed`: a
+    direction, which the API checks before any work, of a protocol with both; a layout's index, below the direction's
+    count), the last case is the default: a `default:` of its own would be code no input reaches. Else `otherwise`
+    (the default's label and statements)."""
+    if closed and cases:
+        label, _, body = cases[-1].partition("\n")
+        pad = label[: len(label) - len(label.lstrip())]
+        name = label.strip().removeprefix("case ").removesuffix(":")
+        return "\n".join([*cases[:-1], f"{pad}default: /* {name} */\n{body}"])
+    return "\n".join([*cases, otherwise])
 
 
 def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:

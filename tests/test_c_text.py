@@ -208,7 +208,9 @@ def test_compiles_without_a_warning(name: str, level: str, build: str, tmp_path:
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_header_compiles_as_cpp11_and_switches_leave_parts_out_without_a_warning(name: str, tmp_path: Path) -> None:
+def test_header_compiles_as_cpp11_and_switches_and_roles_leave_parts_out_without_a_warning(
+    name: str, tmp_path: Path
+) -> None:
     folder = built(name).folder / "c" / name
     if GXX is not None:
         done = subprocess.run([GXX, "-std=c++11", "-pedantic", "-Wall", "-Wextra", "-Werror", "-x", "c++",
@@ -216,7 +218,8 @@ def test_header_compiles_as_cpp11_and_switches_leave_parts_out_without_a_warning
         assert done.returncode == 0, done.stderr
     P = name.upper()
     off = [f"-D{P}_ENABLE_{part}=0" for part in ("ENCODE", "PARSER", "DECODE")]
-    for switches in (off[:1], off[1:2], off[1:], off, off[:2]):
+    roles = [[f"-D{P}_ROLE={P}_ROLE_{role}"] for role in ("HOST", "DEVICE")]  # the parser's role checks too
+    for switches in (off[:1], off[1:2], off[1:], off, off[:2], *roles):
         done = subprocess.run([str(GCC), *FLAGS, *switches, "-c", str(folder / f"{name}.c"), "-o", str(tmp_path / "o")],
                               capture_output=True, text=True)  # fmt: skip
         assert done.returncode == 0, (switches, done.stderr)
@@ -329,6 +332,27 @@ def test_encode_refuses_out_of_range_values_and_never_writes_past_cap() -> None:
     assert answer.startswith("err E_RANGE "), answer
     with pytest.raises(EncodeError, match="outside its range"):
         b.framing.encode_sentence(b.framing.decode(too_big, "request"))
+
+
+@pytest.mark.skipif(GCC is None, reason="no C compiler")
+def test_to_json_of_no_message_writes_null(tmp_path: Path) -> None:
+    """`p_to_json(NULL, ...)` read the kind of no message (a crash); the binary targets write `null`."""
+    name = NAMES[0]
+    folder = built(name).folder / "c" / name
+    program = tmp_path / "null.c"
+    program.write_text(
+        f'#include <stdio.h>\n#include "{name}_json.h"\n'
+        f"int main(void) {{ char out[16]; size_t n = {name}_to_json(NULL, out, sizeof(out)); "
+        'printf("%u %s\\n", (unsigned)n, out); return 0; }\n',
+        encoding="utf-8",
+    )
+    binary = tmp_path / "null"
+    sources = [str(program), str(folder / f"{name}.c"), str(folder / f"{name}_json.c")]
+    done = subprocess.run(
+        [str(GCC), *FLAGS, f"-I{folder}", *sources, "-o", str(binary)], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert subprocess.run([str(binary)], capture_output=True, text=True, timeout=30).stdout == "4 null\n"
 
 
 def _texts(value: Any) -> Any:

@@ -1977,37 +1977,6 @@ size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size
     if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
         return len;
     }
-
-nmea0183_event_t nmea0183_parser_push(nmea0183_parser_t *parser, uint8_t byte, nmea0183_msg_t *out)
-{
-#if NMEA0183_ROLE != NMEA0183_ROLE_BOTH
-    if (!NMEA0183__DECODES(parser->dir)) { /* the other side's direction, left out of this build */
-        return NMEA0183_EVENT_NONE;
-    }
-#endif
-    switch (nmea0183__push(parser, byte, out)) {
-    case 1:
-        return NMEA0183_EVENT_MESSAGE;
-    case 2:
-        return NMEA0183_EVENT_FRAME_UNKNOWN;
-    default:
-        return NMEA0183_EVENT_NONE;
-    }
-}
-
-const uint8_t *nmea0183_parser_frame(const nmea0183_parser_t *parser, size_t *len)
-{
-    if (len != NULL) {
-        *len = parser->frame_len;
-    }
-    return parser->frame;
-}
-
-void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
-{
-    (void)parser;
-    (void)reply;
-}
 #endif
     for (i = 0u; i < len; i++) {
         if (nmea0183__push(parser, data[i], out) == 1) {

@@ -105,7 +105,7 @@ size_t nmea0183_to_json(const nmea0183_msg_t *msg, char *out, size_t cap)
     if (c.pos < c.n) {
         c.pos++;
     }
-    switch (msg->kind) {
+    switch (msg == NULL ? NMEA0183_KIND_NONE : msg->kind) { /* no message: null, as the binary targets write */
     case NMEA0183_GGA_RESPONSE:
         nmea0183__j_str(&j, "{\"command\":\"gga\",\"subcommand\":null,\"direction\":\"response\",");
         nmea0183__j_head(&j, msg);

@@ -550,14 +550,17 @@ static int {p}__special(uint8_t c)
             return written(pieces, helpers).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
 
         runtime = prefixed(parts)
-        # the firmware API beside the parser (parser_api.py), inside the parser's feature switch
-        parser = prefixed([PARSER]).replace(
-            "}\n#endif\n",
-            "}\n"
+        # the firmware API beside the parser (parser_api.py), inside the parser's feature switch: before its last
+        # #endif (the others close role checks inside functions)
+        body, closing, _ = prefixed([PARSER]).rpartition("}\n#endif\n")
+        assert closing, "the parser piece ends its feature switch"
+        parser = (
+            body
+            + "}\n"
             + parser_api.push_function(p, P, None)
             + parser_api.frame_function(p)
             + parser_api.expect_function(p, P, True)
-            + "#endif\n",
+            + "#endif\n"
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
@@ -968,7 +971,7 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     if (c.pos < c.n) {{
         c.pos++;
     }}
-    switch (msg->kind) {{
+    switch (msg == NULL ? {P}_KIND_NONE : msg->kind) {{ /* no message: null, as the binary targets write */
 {chr(10).join(cases)}
     case {P}_KIND_NONE:
     case {P}_KIND_COUNT:

@@ -567,9 +567,6 @@ CASES["frame: error header (error_value), an error reply without fields"] = Case
     },
     {"refused": {"response": {"error_reply": True, "fields": {}}}},
 )
-C_REFUSES["frame: error header (error_value), an error reply without fields"] = (
-    "error replies told by their header (`error_value`)"
-)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},

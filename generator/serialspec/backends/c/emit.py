@@ -217,8 +217,6 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
     refuse_by_command(protocol)
-    if protocol.error_reply is not None and not protocol.error_reply.flag:
-        raise Unsupported("error replies told by their header (`error_value`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

@@ -390,6 +390,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     tl = names.index(t.last) if t else 0
     error = ctx.protocol.error_reply
     error_flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
+    if layout.error:  # an error header's layout (`error_value`): every frame of it is an error reply
+        error_flag = ERROR_LAYOUT
     sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in layout.elements]
     first = tf if t else content if content >= 0 else len(sizes)
     last = tl if t else content if content >= 0 else len(sizes) - 1
@@ -507,6 +509,8 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
                 lines.append(f"    if (f[{offset + j}u] != 0x{byte:02x}u) {{ return {P}__NONE; }} /* {e.name} */")
         elif e.role == "command":
             code = f"(({value}) & {flag}UL) != 0u ? {P}__ERROR_CODE : (long)({value})" if flag else f"(long)({value})"
+            if layout.error:  # an error header's layout (`error_value`): the refused request's code
+                code = f"{P}__ERROR_CODE"
             lines.append(f"    code = {code}; /* {e.name} */")
             lines.append(
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
@@ -784,6 +788,8 @@ def source(ctx: Ctx) -> str:
             key = code_key(P, code)
             command = protocol.command(users[0].command)
             body = []
+            if code == ERROR_CODE and protocol.error_reply is not None and not protocol.error_reply.flag:
+                continue  # told by its header (`error_value`): decode_expect decodes it ({p}__decode_refused)
             if code == ERROR_CODE and protocol.error_reply is not None:
                 error = protocol.error_reply
                 element = error_element(protocol, users[0])
@@ -835,6 +841,17 @@ def source(ctx: Ctx) -> str:
     # encoders: public per-message functions
     pub_encoders: list[str] = []
     opt = optional.has_optional(ctx)
+    # error replies told by their header (`error_value`): sent in the error layouts alone, every other message in
+    # the others; decoded from a frame of an error layout
+    refusals = [(d, k) for d in directions(protocol) for k, a in enumerate(protocol.framing.alternatives[d]) if a.error]
+    refusing_param = "int refusing, " if refusals else ""
+    skip_refusal = (
+        f"\n        if ((L->error_flag == {ERROR_LAYOUT}UL) != (refusing != 0)) {{ /* an error header's layout */"
+        "\n            continue;\n        }"
+        if refusals
+        else ""
+    )
+    refused_fn, refused_call = refused_decoder(ctx, refusals)
     xargs = "present, extras, " if opt else ""
     for m in msgs:
         mid = msg_id(m)
@@ -845,7 +862,9 @@ def source(ctx: Ctx) -> str:
         xdecls, vchecks = optional.encode_lines(ctx, m.direction) if opt else ([], [])
         vsets = []
         element = error_element(protocol, m)
-        if element is not None and protocol.error_reply is not None:
+        if element is not None and protocol.error_reply is not None and not protocol.error_reply.flag:
+            wire_code = f"(uint32_t)m->{ident(element[0])}"  # under the error header (`error_value`)
+        elif element is not None and protocol.error_reply is not None:
             flag = protocol.error_reply.flag
             vchecks.append(f"    if ((m->{ident(element[0])} & {flag}u) != 0u) {{ return {P}_E_RANGE; }}")
             wire_code = f"((uint32_t)m->{ident(element[0])} | {flag}UL)"
@@ -876,7 +895,9 @@ def source(ctx: Ctx) -> str:
                     *vchecks,
                     *vsets,
                     *([] if values else ["    values[0] = 0u;"]),
-                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}m, "
+                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}"
+                    + (f"{int(element is not None)}, " if refusals else "")
+                    + f"m, "
                     f"{p}__enc_{mid}, buf, cap, len);",
                     "}",
                     "",
@@ -927,7 +948,7 @@ static size_t {p}__least({p}_direction_t dir)
     no_checksums = "" if cases.strip() else "\n    (void)d;\n    (void)n;"
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     optionals = max((len(optional.elements_of(ctx, d)) for d in directions(protocol)), default=0)
-    xparams = "uint8_t present, const uint8_t *const *extras, " if opt else ""
+    xparams = ("uint8_t present, const uint8_t *const *extras, " if opt else "") + refusing_param
     xdecl = "const uint8_t *const *extras, " if opt else ""
     xarg = "extras, " if opt else ""
     skip_variant = (
@@ -1131,7 +1152,7 @@ static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, 
 
 {admits_fn}
 /* ---- content decoders ---- */
-{decoders}
+{decoders}{refused_fn}
 static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect, const uint8_t *c, size_t n,
                                 const uint32_t *values, {xdecl}{p}_msg_t *out)
 {{
@@ -1184,7 +1205,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
-    }}{find_extras}
+    }}{find_extras}{refused_call}
     r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values,
                             {xarg}out);
     if (r != {P}_OK) {{
@@ -1218,7 +1239,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = {P}__T(L) ? L->t_first : 0u;{skip_variant}
+        uint8_t from = {P}__T(L) ? L->t_first : 0u;{skip_variant}{skip_refusal}
         for (i = from; (int)i < L->content; i++) {{
             before += L->e[i].size;
         }}
@@ -1604,6 +1625,50 @@ const char *{p}_result_name(int result)
 
 
 ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY
+ERROR_LAYOUT = 0xFFFFFFFF  # a layout's error_flag in the tables: an error header's layout (`error_value`)
+
+
+def refused_decoder(ctx: Ctx, refusals: list[tuple[Direction, int]]) -> tuple[str, str]:
+    """Where error replies are told by their header (`error_value`): the function that decodes a frame of an error
+    layout as the error reply (the refused request's code from the command element), and decode_expect's call of it
+    (runtime/framing.py: a frame of a layout with `error` is the error reply)."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    if not refusals:
+        return "", ""
+    m = next(m for m in messages(protocol) if m.error_reply)
+    element = error_element(protocol, m)
+    assert element is not None
+    values = value_elements(protocol, m.direction)
+    xparam = "const uint8_t *const *extras, " if optional.has_optional(ctx) else ""
+    function = "\n".join(
+        [
+            "/* An error reply told by its header (`error_value`): the refused code in the command element. */",
+            f"static int {p}__decode_refused(uint32_t code, const uint8_t *c, size_t n, const uint32_t *values,",
+            f"                              {xparam}{p}_msg_t *out)",
+            "{",
+            "    int r;",
+            "    (void)values;",
+            f"    out->u.{msg_id(m)}.{ident(element[0])} = ({_ctype_of(element[1])})code;",
+            f"    {dec_call(ctx, m, values)}",
+            "}",
+            "",
+        ]
+    )
+    test = " || ".join(f"(dir == {P}_{d.name} && k == {k}u)" for d, k in refusals)
+    xarg = "extras, " if optional.has_optional(ctx) else ""
+    call = "\n".join(
+        [
+            "",
+            f"    if ({test}) {{ /* an error header's layout: the error reply */",
+            f"        r = {p}__decode_refused(code, c, clen, values, {xarg}out);",
+            f"        if (r != {P}_OK) {{",
+            f"            out->kind = {P}_KIND_NONE;",
+            "        }",
+            "        return r;",
+            "    }",
+        ]
+    )
+    return function, call
 
 
 def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:

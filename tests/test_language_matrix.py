@@ -442,7 +442,6 @@ class Built:
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
 C_REFUSES = {
     "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
-    "frame: ended by a terminator, no length": "ended by its trailer alone",
     "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
         "a length inside the transformed span"
     ),
@@ -937,15 +936,7 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
 
     if GCC is None:
         return
-    c_files = [path for path in built.files if path.startswith("c/matrix_case/")]
-    assert c_files, "C files"
-    source = tmp_path / "c"
-    source.mkdir()
-    for path, text in built.files.items():
-        if path.startswith("c/matrix_case/"):
-            target = source / path.removeprefix("c/matrix_case/")
-            target.parent.mkdir(exist_ok=True)
-            target.write_text(text, encoding="utf-8")
+    source = c_source(built, tmp_path)
     # the golden-vector program shipped beside the C, built with the shipped specs' warning flags (the JSON
     # formatter compiled and linked in, so that it is held to them too): the examples decode, encode back and parse
     check = tmp_path / "check_vectors"
@@ -978,6 +969,46 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
                         for fields in both_ways(g, message, element)
                     ]
                     stream_agrees_with_python(run, g, direction, b"".join(both), "2,1,5")
+        finally:
+            run.close()
+
+
+def c_source(built: Built, tmp_path: Path) -> Path:
+    """The case's C files written to tmp_path/c."""
+    c_files = [path for path in built.files if path.startswith("c/matrix_case/")]
+    assert c_files, "C files"
+    source = tmp_path / "c"
+    source.mkdir()
+    for path, text in built.files.items():
+        if path.startswith("c/matrix_case/"):
+            target = source / path.removeprefix("c/matrix_case/")
+            target.parent.mkdir(exist_ok=True)
+            target.write_text(text, encoding="utf-8")
+    return source
+
+
+def test_c_ends_a_frame_at_the_first_trailer_at_which_it_checks(tmp_path: Path) -> None:
+    """Frames ended by their trailer alone (no length, a content of any size): the C parser ends a frame at the first
+    trailer byte at which it checks, as the Python parser does, so a trailer byte inside the content, a checksum that
+    is the trailer byte and garbage full of them give the Python parser's frames, in any split."""
+    from test_c_backend import GCC, Driver, agrees_with_python, stream_agrees_with_python
+
+    if GCC is None:
+        pytest.skip("no gcc")
+    built = build("frame: ended by a terminator, no length")
+    with package(built) as g:
+        request = next(m for m in g.protocol.messages() if m.direction == Direction.REQUEST and m.command == "probe")
+        trailer = g.protocol.framing.layouts[Direction.REQUEST].elements[-1].constant
+        assert trailer == b"\x0d"
+        # code 1 ^ 0x0d ^ 0x0d ^ x: the checksum is the trailer byte itself for x = 0x0c
+        contents = [b"\x0d", b"\x0d\x0d\x0c", b"", b"\x0d\x3a\x0d\x00", b"\x0c"]
+        run = Driver("matrix_case", c_source(built, tmp_path), tmp_path)
+        try:
+            frames = [agrees_with_python(run, g, request, {"v": 0x0D0D, "data": data.hex(" ")}) for data in contents]
+            assert any(frame[-2:] == trailer * 2 for frame in frames)  # a checksum equal to the trailer byte
+            stream = b"\x0d\x3a\x0d".join(frames) + b"\x3a\x01\x0d"
+            for sizes in ("1", "2,5,3", "64"):
+                stream_agrees_with_python(run, g, Direction.REQUEST, stream, sizes)
         finally:
             run.close()
 

@@ -42,7 +42,6 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
-    size_terms,
 )
 
 #: Default capacities where the spec sets no smaller bound (each overridable with #define before the header).
@@ -223,11 +222,6 @@ def refuse_unsupported(protocol: Protocol) -> None:
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             refuse_layout(layout)
-            roles = [e.role for e in layout.elements]
-            terminated = roles[-1] == "trailer" and len(roles) > 1 and "length" not in roles
-            unsized = any(size_terms(m.fields) is None for m in protocol.messages() if m.direction == layout.direction)
-            if terminated and layout.transparency is None and unsized:
-                raise Unsupported(f"the {layout.direction.value} frame: ended by its trailer alone (no length)")
     for message in protocol.messages():
         refuse_fields(message.fields, message.key)
     refuse_wide_values(protocol)

@@ -539,6 +539,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             f"      return {sum(sizes) - counted}L + counted; }}",
         ]
     else:
+        lines += terminated_probe(ctx, direction, k, layout, sum(sizes))
         lines += [
             f"    {{ long size = {p}__content_size({P}_{direction.name}, code, f + {offset}u, avail - {offset}u);",
             "      if (size < 0) { return size; }",
@@ -547,6 +548,43 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
         ]
     lines += ["}", ""]
     return "\n".join(lines)
+
+
+def terminated_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout, overhead: int) -> list[str]:
+    """The probe's lines for a frame ended by its trailer with nothing else to size it (no length, no transform, a
+    code with no size rule): the first occurrence of the trailer at which the frame checks (this layout's unwrap:
+    constants, values, checksums), so a trailer byte inside the content or a checksum does not end it; wait while
+    none has come, no frame past the largest content (runtime/framing.py _terminated). [] for other layouts."""
+    p, P = ctx.p, ctx.P
+    last = layout.elements[-1]
+    if len(layout.elements) < 2 or last.role not in ("header", "trailer", "constant"):
+        return []
+    ruled = [
+        code_key(P, code)
+        for code, users in messages_by_code(ctx.protocol, direction).items()
+        if len(users) == 1 and size_terms(users[0].fields) is not None
+    ]
+    if len(ruled) == len(messages_by_code(ctx.protocol, direction)):
+        return []  # every code's content is sized by its own leading fields
+    trailer = last.constant
+    found = " && ".join(f"f[i + {j}u] == 0x{byte:02x}u" for j, byte in enumerate(trailer))
+    unwrap = f"{p}__unwrap_{direction.value}_{k}(f, i + {len(trailer)}u, &c, v, &content, &clen"
+    unwrap += ", 0)" if length_byte.applies(ctx.protocol) else ")"
+    return [
+        f"    if ({' && '.join(f'code != {key}' for key in ruled) or '1'}) {{",
+        "        /* no size rule: the frame ends at the first trailer at which it checks */",
+        f"        uint32_t c, v[{P}__MAX_ELEMENTS];",
+        "        const uint8_t *content;",
+        "        size_t clen, i;",
+        f"        for (i = {overhead - len(trailer)}u + low; i + {len(trailer)}u <= avail; i++) {{",
+        f"            if ({found}) {{",
+        f"                if (bounded && i + {len(trailer)}u > {overhead}u + high) {{ return {P}__NONE; }}",
+        f"                if ({unwrap} == {P}_OK) {{ return (long)(i + {len(trailer)}u); }}",
+        "            }",
+        "        }",
+        f"        return bounded && avail > {overhead}u + high ? {P}__NONE : {P}__WAIT;",
+        "    }",
+    ]
 
 
 def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
@@ -686,6 +724,7 @@ def source(ctx: Ctx) -> str:
     count_cases: list[str] = []
     least_cases: list[str] = []
     waits = False  # the classic parser waits for a prefix in some direction
+    terminated: list[tuple[Direction, int]] = []  # layouts whose probe calls their unwrap (ended by a trailer)
     for d in directions(protocol):
         alternatives = protocol.framing.alternatives[d]
         fewest = min(_prefix(ctx, a) for a in alternatives)
@@ -705,6 +744,8 @@ def source(ctx: Ctx) -> str:
                 hrows.append(f"        case {k}u:\n            *len = {size}u;\n            return {hname};")
             if layout.transparency is None:
                 probes.append(straight_probe(ctx, d, k, layout))
+                if "__unwrap_" in probes[-1]:  # ended by its trailer: the probe calls the unwrap defined below
+                    terminated.append((d, k))
                 prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail);")
         header_cases.append(
             f"    case {P}_{d.name}:\n        switch (k) {{\n"
@@ -1061,6 +1102,12 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
 """
     probing = (
         "/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */\n"
+    )
+    probing += "".join(
+        f"static int {p}__unwrap_{d.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,\n"
+        "                                 const uint8_t **content, size_t *clen"
+        + (", int sized);\n" if length_byte.applies(protocol) else ");\n")
+        for d, k in terminated
     )
     probing += f"""{chr(10).join(probes)}
 /* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when

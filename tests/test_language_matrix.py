@@ -441,7 +441,6 @@ class Built:
 
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
 C_REFUSES = {
-    "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
     "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
         "a length inside the transformed span"
     ),

@@ -246,8 +246,11 @@ def refuse_layout(layout: FrameLayout) -> None:
     if length >= 0 and length >= first:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):
-        if e.checksum is not None and e.checksum.skips:
-            raise Unsupported(f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}")
+        if e.checksum is not None and e.checksum.skips and t is not None:
+            raise Unsupported(
+                f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}, "
+                "beside a transform"
+            )
         if e.role == "checksum" and t is not None and e.checksum is not None:
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             inside = first <= i <= last

@@ -210,6 +210,7 @@ static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, 
 }
 #endif
 
+/*@gather@*/
 #if PFX_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
@@ -222,6 +223,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     uint8_t first = pfx__inner_first(L);
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
+    /*@covered@*/
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
     if (PFX__T(L)) {
         size_t p = 0u;
@@ -320,6 +322,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
         const pfx__element_t *e = &L->e[k];
         if (e->role == PFX__ROLE_CHECKSUM && !(PFX__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = pfx__range(L, &w, out, span, e->first, e->last, &sz);
+            /*@skip@*/
             pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, bytes, sz));
         }
     }
@@ -531,5 +534,51 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
 }
 #endif
 """
+
+# A checksum over a span that leaves out elements (`skip`: HerkuleX's checksums inside their own span): the table's
+# `minimum` of a checksum element holds them, one bit each, and wrap gathers the other elements' bytes. Put in place
+# of the markers only where a layout has such a checksum (every other protocol's C stays as it was).
+GATHER = r"""#if PFX_ENABLE_ENCODE
+/* The bytes a checksum covers when its span leaves out elements (skip: e->minimum, one bit each), gathered into to
+ * (room for PFX_MAX_FRAME bytes): the other elements' bytes as sent (runtime/framing.py Layout._covered). */
+static int pfx__gather(const pfx__element_t *e, const pfx__where_t *w, const uint8_t *wire, uint8_t *to, size_t *n)
+{
+    size_t m = 0u, i;
+    uint8_t k;
+    for (k = e->first; k <= e->last; k++) {
+        if (((e->minimum >> k) & 1u) != 0u) {
+            continue;
+        }
+        if (w->we[k] - w->ws[k] > PFX_MAX_FRAME - m) {
+            return 0;
+        }
+        for (i = w->ws[k]; i < w->we[k]; i++) {
+            to[m++] = wire[i];
+        }
+    }
+    *n = m;
+    return 1;
+}
+#endif
+
+"""
+SKIP = r"""if (e->minimum != 0u) { /* a span that leaves out elements (skip) */
+                if (!pfx__gather(e, &w, out, covered, &sz)) {
+                    return PFX_E_BUFFER;
+                }
+                bytes = covered;
+            }
+            """
+COVERED = "uint8_t covered[PFX_MAX_FRAME]; /* a checksum's bytes, its span less the elements it skips */\n    "
+MARKERS = ("/*@gather@*/\n", "/*@skip@*/\n            ", "/*@covered@*/\n    ")
+
+
+def with_skips(engine: str, skips: bool) -> str:
+    """The engine with the code for checksums that skip elements (skips), or without it."""
+    for marker, code in zip(MARKERS, (GATHER, SKIP, COVERED), strict=True):
+        assert marker in engine
+        engine = engine.replace(marker, code if skips else "")
+    return engine
+
 
 ENGINE = HEAD + GET + TAIL

@@ -23,7 +23,7 @@ from serialspec.backends.c.emit import (
     spec_hash,
     value_elements,
 )
-from serialspec.backends.c.engine import GET, HEAD, TAIL
+from serialspec.backends.c.engine import GET, HEAD, TAIL, with_skips
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
@@ -362,6 +362,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             first, last = needs[e.name]
         value = e.role in (*VALUE_ROLES, "command")
         minimum = int(e.minimum) if value else 0
+        if e.role == "checksum" and e.checksum is not None and e.checksum.skips:  # the elements left out, a bit each
+            minimum = sum(1 << names.index(name) for name in e.checksum.skips)
         maximum = int(e.maximum) if value else 0
         also = e.broadcast if value and e.broadcast is not None else None
         rows.append(
@@ -411,6 +413,15 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
     return "\n".join(lines), name
+
+
+def every_layout(protocol: Protocol) -> list[FrameLayout]:
+    return [layout for layouts in protocol.framing.alternatives.values() for layout in layouts]
+
+
+def skips_of(layout: FrameLayout) -> bool:
+    """Some checksum of the layout covers a span that leaves out elements (`skip`)."""
+    return any(e.checksum is not None and e.checksum.skips for e in layout.elements)
 
 
 def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
@@ -683,6 +694,25 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
             value = _wire_value(start[i], sizes[i], e.endian == ">")
+            if e.checksum.skips:  # its span less the elements it leaves out, gathered (runtime Layout._covered)
+                left = {names.index(name) for name in e.checksum.skips}
+                runs: list[tuple[int, int]] = []
+                for j in range(a, b + 1):
+                    if j not in left and runs and runs[-1][1] == j - 1:
+                        runs[-1] = (runs[-1][0], j)
+                    elif j not in left:
+                        runs.append((j, j))
+                lines += [
+                    f"    {{ uint8_t covered[{P}_MAX_FRAME]; /* {e.name}: {', '.join(e.checksum.skips)} left out */",
+                    "      size_t m = 0u, i;",
+                    f"      if (n > {P}_MAX_FRAME) {{ return {P}_E_CAPACITY; }}",
+                ]
+                for x, y in runs:
+                    lines.append(f"      for (i = {at(start[x])}; i < {at(end[y])}; i++) {{ covered[m++] = f[i]; }}")
+                lines.append(
+                    f"      if ({p}__check({check}u, covered, m) != ({value})) {{ return {P}_E_CHECKSUM; }} }}"
+                )
+                continue
             lines.append(
                 f"    if ({p}__check({check}u, f + {at(start[a])}, {span(a, b)}) != ({value})) {{ "
                 f"return {P}_E_CHECKSUM; }} /* {e.name} */"
@@ -796,6 +826,7 @@ def source(ctx: Ctx) -> str:
     any_stuffed = any(stuffed.values())
     # __get: read by the engine's code for stuffed layouts and by the content code that asks for it
     engine = HEAD + (GET if any_stuffed or "get" in ctx.helpers else "") + TAIL
+    engine = with_skips(engine, any(skips_of(layout) for layout in every_layout(protocol)))
     engine = engine.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
     engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks

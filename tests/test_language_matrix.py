@@ -441,9 +441,6 @@ class Built:
 
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
 C_REFUSES = {
-    "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
-        "a length inside the transformed span"
-    ),
     "transform: cobs, after a header, with a length inside the span (it counts the plain bytes)": (
         "a length inside the transformed span"
     ),
@@ -1007,6 +1004,30 @@ def test_c_ends_a_frame_at_the_first_trailer_at_which_it_checks(tmp_path: Path) 
             assert any(frame[-2:] == trailer * 2 for frame in frames)  # a checksum equal to the trailer byte
             stream = b"\x0d\x3a\x0d".join(frames) + b"\x3a\x01\x0d"
             for sizes in ("1", "2,5,3", "64"):
+                stream_agrees_with_python(run, g, Direction.REQUEST, stream, sizes)
+        finally:
+            run.close()
+
+
+def test_c_reads_a_length_escaped_inside_the_span(tmp_path: Path) -> None:
+    """XBee API mode 2 in C: a length inside the escaped span counting its plain bytes, itself escaped (0x11, 0x13,
+    0x7D, 0x7E), and contents full of escaped bytes: the C encodes and decodes them as Python does and its parser,
+    fed in pieces, sizes them through the escapes and gives the Python parser's frames among garbage."""
+    from test_c_backend import GCC, Driver, agrees_with_python, stream_agrees_with_python
+
+    if GCC is None:
+        pytest.skip("no gcc")
+    built = build("transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)")
+    with package(built) as g:
+        request = next(m for m in g.protocol.messages() if m.direction == Direction.REQUEST and m.command == "probe")
+        # the length counts the code, v and the data: 3 + len(data)
+        contents = [bytes(0x11 - 3), b"\x7e" * (0x13 - 3), b"\x7d\x11" * 61, b"\x13\x7e", b""]
+        run = Driver("matrix_case", c_source(built, tmp_path), tmp_path)
+        try:
+            frames = [agrees_with_python(run, g, request, {"v": 0x7D7E, "data": data.hex(" ")}) for data in contents]
+            assert [f[1:4].hex() for f in frames[:3]] == ["007d31", "007d33", "007d5d"]  # each length escaped
+            stream = b"\x7e\x00\x7d".join(frames) + b"\x7e\x00\x7d\x31\x01"
+            for sizes in ("1", "3,1,7", "300"):
                 stream_agrees_with_python(run, g, Direction.REQUEST, stream, sizes)
         finally:
             run.close()

@@ -43,6 +43,7 @@ from serialspec.lang.model import (
     TableValue,
     Text,
 )
+from serialspec.transforms.replace import Replace
 
 #: Default capacities where the spec sets no smaller bound (each overridable with #define before the header).
 DEFAULT_MAX_BYTES = 256  # bytes, text, per field
@@ -241,9 +242,11 @@ def refuse_layout(layout: FrameLayout) -> None:
     first = names.index(t.first) if t else content if content >= 0 else len(elements)
     last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
     length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
-    if length >= 0 and t is not None and first <= length <= last:
+    inner = length >= 0 and t is not None and first <= length <= last
+    if t is not None and inner and (not isinstance(t.transform, Replace) or not plain_span(layout)):
+        # (a substitution's, counting plain bytes of the span: the engine reads it through the pairs)
         raise Unsupported(f"{where}: a length inside the transformed span")
-    if length >= 0 and length >= first:
+    if length >= 0 and length >= first and not inner:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):
         if e.checksum is not None and e.checksum.skips and t is not None:
@@ -256,6 +259,16 @@ def refuse_layout(layout: FrameLayout) -> None:
             inside = first <= i <= last
             if inside and not (first <= a and b <= last):
                 raise Unsupported(f"{where}: checksum {e.name} inside the stuffed span over bytes outside it")
+
+
+def plain_span(layout: FrameLayout) -> bool:
+    """The layout's length counts elements inside its transformed span (their plain bytes)."""
+    t, length = layout.transparency, layout.length
+    if t is None or length is None:
+        return False
+    names = [e.name for e in layout.elements]
+    first, last = names.index(t.first), names.index(t.last)
+    return first <= names.index(length.counts[0]) and names.index(length.counts[1]) <= last
 
 
 def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -> None:

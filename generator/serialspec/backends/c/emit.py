@@ -243,8 +243,11 @@ def refuse_layout(layout: FrameLayout) -> None:
     last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
     length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
     inner = length >= 0 and t is not None and first <= length <= last
-    if t is not None and inner and (not isinstance(t.transform, Replace) or not plain_span(layout)):
-        # (a substitution's, counting plain bytes of the span: the engine reads it through the pairs)
+    code = t.transform.c_code("p") if t is not None else None
+    readable = t is not None and (isinstance(t.transform, Replace) or (code is not None and bool(code.plain_prefix)))
+    if t is not None and inner and (not readable or not plain_span(layout)):
+        # (counting plain bytes of the span, under a substitution or a transform whose C has plain_prefix: the
+        # engine reads it through them)
         raise Unsupported(f"{where}: a length inside the transformed span")
     if length >= 0 and length >= first and not inner:
         raise Unsupported(f"{where}: a length after the variable part of the frame")

@@ -603,7 +603,7 @@ static long pfx__plain_prefix(const pfx__layout_t *L, const uint8_t *b, size_t s
 {
     size_t n = 0u, pos = start, t;
     uint8_t k;
-    while (n < count) {
+    /*@transform_prefix@*/while (n < count) {
         int matched = 0;
         if (pos >= avail) {
             return PFX__WAIT;
@@ -673,11 +673,20 @@ static long pfx__inner_size(const pfx__layout_t *L, const pfx__element_t *e, con
 INNER_MARKERS = ("/*@inner_lengths@*/", "/*@outer_length@*/", "/*@inner_size@*/", "/*@plain_prefix@*/")
 
 
-def with_inner_lengths(engine: str, inner: bool) -> str:
-    """The engine with the code for lengths of plain bytes inside a stuffed span (inner), or without it."""
+TRANSFORM_PREFIX = r"""if (L->has_t >= 2u) { /* a transform of its own C (serialspec/transforms/) */
+        return pfx__transform_prefix(L->has_t, b, start, avail, count, from, dst);
+    }
+    """
+
+
+def with_inner_lengths(engine: str, inner: bool, transformed: bool) -> str:
+    """The engine with the code for lengths of plain bytes inside a stuffed span (inner; transformed: under a
+    transform of its own C, not only substitution), or without it."""
     for marker, code in zip(INNER_MARKERS, (INNER_LENGTHS, OUTER_LENGTH, INNER_SIZE, PLAIN_PREFIX), strict=True):
         assert marker in engine
         engine = engine.replace(marker, code if inner else "")
+    if inner:
+        engine = engine.replace("/*@transform_prefix@*/", TRANSFORM_PREFIX if transformed else "")
     return engine
 
 

@@ -27,6 +27,7 @@ from serialspec.backends.c.emit import (
 from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, with_skips
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
+from serialspec.backends.c.transforms import prefixes as transform_prefixes
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
 from serialspec.transforms.replace import Replace
 
@@ -828,7 +829,9 @@ def source(ctx: Ctx) -> str:
     # __get: read by the engine's code for stuffed layouts and by the content code that asks for it
     engine = HEAD + (GET if any_stuffed or "get" in ctx.helpers else "") + TAIL
     engine = with_skips(engine, any(skips_of(layout) for layout in every_layout(protocol)))
-    engine = with_inner_lengths(engine, any(plain_span(layout) for layout in every_layout(protocol)))
+    engine = with_inner_lengths(
+        engine, any(plain_span(layout) for layout in every_layout(protocol)), transform_prefixes(protocol, p)
+    )
     engine = engine.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
     engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks

@@ -134,7 +134,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
-    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none; all 1s: an error header) */
     uint16_t overhead;   /* every element's size but the content's */
     uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
     uint16_t after;      /* bytes after it */
@@ -556,7 +556,8 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
             }
         } else if (e->role == CRSF__ROLE_COMMAND) {
             uint32_t value = crsf__get(b + pos, e->size, e->big);
-            code = (value & L->error_flag) != 0u ? CRSF__ERROR_CODE : (long)value;
+            /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
+            code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? CRSF__ERROR_CODE : (long)value;
             if (!crsf__bounds(dir, code, &low, &high, &bounded)) {
                 return CRSF__NONE;
             }

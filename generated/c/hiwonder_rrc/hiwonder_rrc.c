@@ -134,7 +134,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
-    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none; all 1s: an error header) */
     uint16_t overhead;   /* every element's size but the content's */
     uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
     uint16_t after;      /* bytes after it */
@@ -556,7 +556,8 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             }
         } else if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
             uint32_t value = hiwonder_rrc__get(b + pos, e->size, e->big);
-            code = (value & L->error_flag) != 0u ? HIWONDER_RRC__ERROR_CODE : (long)value;
+            /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
+            code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? HIWONDER_RRC__ERROR_CODE : (long)value;
             if (!hiwonder_rrc__bounds(dir, code, &low, &high, &bounded)) {
                 return HIWONDER_RRC__NONE;
             }

@@ -97,12 +97,19 @@ class CTransform:
     (the engine's re-encoding check after a decode): 1 when the wire form of src is cmp[0..cap), or 1 at once (and
     *out = cap) for a transform whose decoding checks the form itself. `code` is its C (with any helpers).
     `span_end` (or ""): `static long NAME(const uint8_t *b, size_t start, size_t avail)`, where the span that starts
-    at b[start] ends on the wire (the runtime's span_end), -2 while the bytes end inside it; `span_code` its C."""
+    at b[start] ends on the wire (the runtime's span_end), -2 while the bytes end inside it; `span_code` its C.
+    `plain_prefix` (or ""): `static long NAME(const uint8_t *b, size_t start, size_t avail, size_t count, size_t
+    from, uint8_t *dst)`, the runtime's plain_prefix: the wire bytes from b[start] that give the span's first `count`
+    plain bytes, -2 while more are needed, -1 where none do (the span ends first, bytes of no form); the plain bytes
+    from index `from` on go to dst. With it, a length inside the span that counts its plain bytes generates in C;
+    `prefix_code` its C."""
 
     rewrite: str
     code: str
     span_end: str = ""
     span_code: str = ""
+    plain_prefix: str = ""
+    prefix_code: str = ""
 
 
 _REGISTERED: dict[str, type[Transform]] = {}

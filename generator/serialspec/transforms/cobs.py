@@ -194,11 +194,54 @@ class Cobs(Transform):
     def c_code(self, prefix: str) -> CTransform:
         name = f"{prefix}__cobs"
         code = _C_COBS.replace("NAME", name).replace("CODE_AFTER_FULL_RUN", "1" if self.code_after_full_run else "0")
-        return CTransform(name, code)
+        return CTransform(name, code, plain_prefix=f"{name}_prefix", prefix_code=_C_PREFIX.replace("NAME", name))
 
     def lua(self) -> dict[str, Any] | None:
         return {"method": "cobs"}  # the dissector decodes, and decoding takes both forms
 
+
+_C_PREFIX = r"""/* The COBS bytes from b[start] that give the span's first `count` plain bytes (_decode with a count, as
+ * CobsSpan.plain_prefix): -2 while more are needed, -1 where none do (a 00 ends the span first, a 00 inside a run).
+ * The plain bytes from index `from` on go to dst. */
+static long NAME_prefix(const uint8_t *b, size_t start, size_t avail, size_t count, size_t from, uint8_t *dst)
+{
+    size_t n = 0u, pos = start, i, stop;
+    while (n < count) {
+        uint8_t code;
+        if (pos >= avail) {
+            return -2L;
+        }
+        code = b[pos];
+        if (code == 0u) {
+            return -1L; /* the span ended before count plain bytes */
+        }
+        stop = pos + code < avail ? pos + code : avail;
+        for (i = pos + 1u; i < stop; i++) {
+            if (b[i] == 0u) {
+                return -1L;
+            }
+        }
+        for (i = pos + 1u; i < stop; i++, n++) {
+            if (n >= from && n < count) {
+                dst[n - from] = b[i];
+            }
+        }
+        if (pos + code > avail) {
+            return n >= count ? (long)(avail - start) : -2L;
+        }
+        pos += code;
+        if (code < 0xFFu && pos < avail && b[pos] != 0u) {
+            if (n >= from && n < count) {
+                dst[n - from] = 0u; /* the 00 the code byte stands for */
+            }
+            n++;
+        } else if (code < 0xFFu && pos >= avail) {
+            return n >= count ? (long)(pos - start) : -2L; /* the span may go on: is the 00 there or not? */
+        }
+    }
+    return (long)(pos - start);
+}
+"""
 
 _C_COBS = r"""/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes
  * (to_wire), or back (0 for bytes that are no COBS form: a 00, a run past the end). Decoding checks the form itself:

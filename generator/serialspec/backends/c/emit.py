@@ -42,8 +42,8 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
-    size_terms,
 )
+from serialspec.transforms.replace import Replace
 
 #: Default capacities where the spec sets no smaller bound (each overridable with #define before the header).
 DEFAULT_MAX_BYTES = 256  # bytes, text, per field
@@ -217,19 +217,12 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
     refuse_by_command(protocol)
-    if protocol.error_reply is not None and not protocol.error_reply.flag:
-        raise Unsupported("error replies told by their header (`error_value`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             refuse_layout(layout)
-            roles = [e.role for e in layout.elements]
-            terminated = roles[-1] == "trailer" and len(roles) > 1 and "length" not in roles
-            unsized = any(size_terms(m.fields) is None for m in protocol.messages() if m.direction == layout.direction)
-            if terminated and layout.transparency is None and unsized:
-                raise Unsupported(f"the {layout.direction.value} frame: ended by its trailer alone (no length)")
     for message in protocol.messages():
         refuse_fields(message.fields, message.key)
     refuse_wide_values(protocol)
@@ -249,18 +242,36 @@ def refuse_layout(layout: FrameLayout) -> None:
     first = names.index(t.first) if t else content if content >= 0 else len(elements)
     last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
     length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
-    if length >= 0 and t is not None and first <= length <= last:
+    inner = length >= 0 and t is not None and first <= length <= last
+    code = t.transform.c_code("p") if t is not None else None
+    readable = t is not None and (isinstance(t.transform, Replace) or (code is not None and bool(code.plain_prefix)))
+    if t is not None and inner and (not readable or not plain_span(layout)):
+        # (counting plain bytes of the span, under a substitution or a transform whose C has plain_prefix: the
+        # engine reads it through them)
         raise Unsupported(f"{where}: a length inside the transformed span")
-    if length >= 0 and length >= first:
+    if length >= 0 and length >= first and not inner:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):
-        if e.checksum is not None and e.checksum.skips:
-            raise Unsupported(f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}")
+        if e.checksum is not None and e.checksum.skips and t is not None:
+            raise Unsupported(
+                f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}, "
+                "beside a transform"
+            )
         if e.role == "checksum" and t is not None and e.checksum is not None:
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             inside = first <= i <= last
             if inside and not (first <= a and b <= last):
                 raise Unsupported(f"{where}: checksum {e.name} inside the stuffed span over bytes outside it")
+
+
+def plain_span(layout: FrameLayout) -> bool:
+    """The layout's length counts elements inside its transformed span (their plain bytes)."""
+    t, length = layout.transparency, layout.length
+    if t is None or length is None:
+        return False
+    names = [e.name for e in layout.elements]
+    first, last = names.index(t.first), names.index(t.last)
+    return first <= names.index(length.counts[0]) and names.index(length.counts[1]) <= last
 
 
 def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -> None:

@@ -71,7 +71,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
-    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none; all 1s: an error header) */
     uint16_t overhead;   /* every element's size but the content's */
     uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
     uint16_t after;      /* bytes after it */
@@ -212,6 +212,7 @@ static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, 
 }
 #endif
 
+/*@gather@*/
 #if PFX_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
  * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
@@ -224,6 +225,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     uint8_t first = pfx__inner_first(L);
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
+    /*@covered@*/
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
 #if PFX__STUFFED
     if (PFX__T(L)) {
@@ -253,7 +255,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
                 v++;
             }
         }
-        for (k = L->t_first; k <= L->t_last; k++) {
+        /*@inner_lengths@*/for (k = L->t_first; k <= L->t_last; k++) {
             const pfx__element_t *e = &L->e[k];
             if (e->role == PFX__ROLE_CHECKSUM) {
                 bytes = span + w.ps[e->first];
@@ -312,7 +314,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     /* lengths, then the checksums outside the stuffed span, over the wire bytes */
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
-        if (e->role == PFX__ROLE_LENGTH) {
+        if (e->role == PFX__ROLE_LENGTH/*@outer_length@*/) {
             int32_t value;
             uint32_t top = e->size >= 4u ? 0xFFFFFFFFu : ((uint32_t)1u << (8u * e->size)) - 1u;
             (void)pfx__range(L, &w, out, span, e->first, e->last, &sz);
@@ -327,6 +329,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
         const pfx__element_t *e = &L->e[k];
         if (e->role == PFX__ROLE_CHECKSUM && !(PFX__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = pfx__range(L, &w, out, span, e->first, e->last, &sz);
+            /*@skip@*/
             pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, bytes, sz));
         }
     }
@@ -444,7 +447,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
 }
 #endif
 
-#if PFX_ENABLE_PARSER && PFX__STUFFED
+/*@plain_prefix@*/#if PFX_ENABLE_PARSER && PFX__STUFFED
 static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 #if PFX__SIZED
 static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, size_t avail);
@@ -473,7 +476,8 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             }
         } else if (e->role == PFX__ROLE_COMMAND) {
             uint32_t value = pfx__get(b + pos, e->size, e->big);
-            code = (value & L->error_flag) != 0u ? PFX__ERROR_CODE : (long)value;
+            /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
+            code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? PFX__ERROR_CODE : (long)value;
             if (!pfx__bounds(dir, code, &low, &high, &bounded)) {
                 return PFX__NONE;
             }
@@ -496,7 +500,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
     }
     if (PFX__LENGTHS || L->length >= 0) {
         const pfx__element_t *e = &L->e[L->length];
-        long counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        /*@inner_size@*/long counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
         if (content < (long)low || (!PFX__T(L) && bounded && content > (long)high)) {
             return PFX__NONE;
@@ -543,5 +547,168 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
 }
 #endif
 """
+
+# A checksum over a span that leaves out elements (`skip`: HerkuleX's checksums inside their own span): the table's
+# `minimum` of a checksum element holds them, one bit each, and wrap gathers the other elements' bytes. Put in place
+# of the markers only where a layout has such a checksum (every other protocol's C stays as it was).
+GATHER = r"""#if PFX_ENABLE_ENCODE
+/* The bytes a checksum covers when its span leaves out elements (skip: e->minimum, one bit each), gathered into to
+ * (room for PFX_MAX_FRAME bytes): the other elements' bytes as sent (runtime/framing.py Layout._covered). */
+static int pfx__gather(const pfx__element_t *e, const pfx__where_t *w, const uint8_t *wire, uint8_t *to, size_t *n)
+{
+    size_t m = 0u, i;
+    uint8_t k;
+    for (k = e->first; k <= e->last; k++) {
+        if (((e->minimum >> k) & 1u) != 0u) {
+            continue;
+        }
+        if (w->we[k] - w->ws[k] > PFX_MAX_FRAME - m) {
+            return 0;
+        }
+        for (i = w->ws[k]; i < w->we[k]; i++) {
+            to[m++] = wire[i];
+        }
+    }
+    *n = m;
+    return 1;
+}
+#endif
+
+"""
+SKIP = r"""if (e->minimum != 0u) { /* a span that leaves out elements (skip) */
+                if (!pfx__gather(e, &w, out, covered, &sz)) {
+                    return PFX_E_BUFFER;
+                }
+                bytes = covered;
+            }
+            """
+COVERED = "uint8_t covered[PFX_MAX_FRAME]; /* a checksum's bytes, its span less the elements it skips */\n    "
+MARKERS = ("/*@gather@*/\n", "/*@skip@*/\n            ", "/*@covered@*/\n    ")
+
+
+# A length inside the stuffed span that counts plain bytes (XBee API mode 2: the length escaped with the rest):
+# made before the span is stuffed, and read by the parser through the substitution. Put in place of its markers only
+# where a layout has one.
+INNER_LENGTHS = r"""/* lengths inside the span count its plain bytes: made before it is stuffed */
+        for (k = L->t_first; k <= L->t_last; k++) {
+            const pfx__element_t *e = &L->e[k];
+            if (e->role == PFX__ROLE_LENGTH) {
+                int32_t value = (int32_t)(w.pe[e->last] - w.ps[e->first]) + e->adds;
+                uint32_t top = e->size >= 4u ? 0xFFFFFFFFu : ((uint32_t)1u << (8u * e->size)) - 1u;
+                if (value < 0 || (uint32_t)value > top) {
+                    return PFX_E_LENGTH;
+                }
+                pfx__put(span + w.ps[k], e->size, e->big, (uint32_t)value);
+            }
+        }
+        """
+OUTER_LENGTH = " && !(PFX__T(L) && k >= L->t_first && k <= L->t_last)"
+INNER_SIZE = r"""if (PFX__T(L) && e->first >= L->t_first && e->last <= L->t_last) {
+            return pfx__inner_size(L, e, b, before, avail, low, high, bounded);
+        }
+        """
+PLAIN_PREFIX = r"""#if PFX_ENABLE_PARSER && PFX__STUFFED
+/* The wire bytes from b[start] on that give the first `count` plain bytes of the stuffed span (runtime/framing.py
+ * Transparency.plain_prefix: at each position the first pair whose wire sequence is there, else the byte itself);
+ * PFX__WAIT while a wire sequence may be cut off at avail. The plain bytes from index `from` on go to dst. */
+static long pfx__plain_prefix(const pfx__layout_t *L, const uint8_t *b, size_t start, size_t avail, size_t count,
+                              size_t from, uint8_t *dst)
+{
+    size_t n = 0u, pos = start, t;
+    uint8_t k;
+    /*@transform_prefix@*/while (n < count) {
+        int matched = 0;
+        if (pos >= avail) {
+            return PFX__WAIT;
+        }
+        for (k = 0u; k < L->npairs && !matched; k++) {
+            const pfx__pair_t *q = &L->pairs[k];
+            if (q->wire_len <= avail - pos && pfx__same(b + pos, q->wire, q->wire_len)) {
+                for (t = 0u; t < q->plain_len; t++, n++) {
+                    if (n >= from && n < count) {
+                        dst[n - from] = q->plain[t];
+                    }
+                }
+                pos += q->wire_len;
+                matched = 1;
+            } else if (q->wire_len > avail - pos && pfx__same(b + pos, q->wire, avail - pos)) {
+                return PFX__WAIT; /* the buffer may end inside this wire sequence */
+            }
+        }
+        if (!matched) {
+            if (n >= from) {
+                dst[n - from] = b[pos];
+            }
+            n++;
+            pos++;
+        }
+    }
+    return (long)(pos - start);
+}
+
+/* The size of a frame whose length counts plain bytes inside the stuffed span (runtime/framing.py _inner_size): its
+ * value read through the substitution where it lies inside the span, then as many plain bytes of the span. */
+static long pfx__inner_size(const pfx__layout_t *L, const pfx__element_t *e, const uint8_t *b, size_t before,
+                            size_t avail, size_t low, size_t high, int bounded)
+{
+    uint8_t value[4];
+    size_t at = 0u, fixed = 0u;
+    long counted, content, used;
+    uint8_t k;
+    for (k = L->t_first; k <= L->t_last; k++) {
+        if ((int)k < (int)L->length) {
+            at += L->e[k].size;
+        }
+        fixed += L->e[k].size;
+    }
+    if ((int)L->length >= (int)L->t_first) {
+        used = pfx__plain_prefix(L, b, before, avail, at + e->size, at, value);
+        if (used < 0) {
+            return used;
+        }
+        counted = (long)pfx__get(value, e->size, e->big) - (long)e->adds;
+    } else {
+        counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+    }
+    content = counted - (long)L->counted;
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return PFX__NONE;
+    }
+    used = pfx__plain_prefix(L, b, before, avail, fixed - L->counted + (size_t)counted, (size_t)-1, value);
+    if (used < 0) {
+        return used;
+    }
+    return (long)before + used + (long)L->after;
+}
+#endif
+
+"""
+INNER_MARKERS = ("/*@inner_lengths@*/", "/*@outer_length@*/", "/*@inner_size@*/", "/*@plain_prefix@*/")
+
+
+TRANSFORM_PREFIX = r"""if (L->has_t >= 2u) { /* a transform of its own C (serialspec/transforms/) */
+        return pfx__transform_prefix(L->has_t, b, start, avail, count, from, dst);
+    }
+    """
+
+
+def with_inner_lengths(engine: str, inner: bool, transformed: bool) -> str:
+    """The engine with the code for lengths of plain bytes inside a stuffed span (inner; transformed: under a
+    transform of its own C, not only substitution), or without it."""
+    for marker, code in zip(INNER_MARKERS, (INNER_LENGTHS, OUTER_LENGTH, INNER_SIZE, PLAIN_PREFIX), strict=True):
+        assert marker in engine
+        engine = engine.replace(marker, code if inner else "")
+    if inner:
+        engine = engine.replace("/*@transform_prefix@*/", TRANSFORM_PREFIX if transformed else "")
+    return engine
+
+
+def with_skips(engine: str, skips: bool) -> str:
+    """The engine with the code for checksums that skip elements (skips), or without it."""
+    for marker, code in zip(MARKERS, (GATHER, SKIP, COVERED), strict=True):
+        assert marker in engine
+        engine = engine.replace(marker, code if skips else "")
+    return engine
+
 
 ENGINE = HEAD + GET + TAIL

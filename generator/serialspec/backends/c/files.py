@@ -20,12 +20,14 @@ from serialspec.backends.c.emit import (
     members,
     messages,
     msg_id,
+    plain_span,
     spec_hash,
     value_elements,
 )
-from serialspec.backends.c.engine import GET, HEAD, TAIL
+from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, with_skips
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
+from serialspec.backends.c.transforms import prefixes as transform_prefixes
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
 from serialspec.transforms.replace import Replace
 
@@ -362,6 +364,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             first, last = needs[e.name]
         value = e.role in (*VALUE_ROLES, "command")
         minimum = int(e.minimum) if value else 0
+        if e.role == "checksum" and e.checksum is not None and e.checksum.skips:  # the elements left out, a bit each
+            minimum = sum(1 << names.index(name) for name in e.checksum.skips)
         maximum = int(e.maximum) if value else 0
         also = e.broadcast if value and e.broadcast is not None else None
         rows.append(
@@ -390,6 +394,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     tl = names.index(t.last) if t else 0
     error = ctx.protocol.error_reply
     error_flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
+    if layout.error:  # an error header's layout (`error_value`): every frame of it is an error reply
+        error_flag = ERROR_LAYOUT
     sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in layout.elements]
     first = tf if t else content if content >= 0 else len(sizes)
     last = tl if t else content if content >= 0 else len(sizes) - 1
@@ -409,6 +415,15 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
     return "\n".join(lines), name
+
+
+def every_layout(protocol: Protocol) -> list[FrameLayout]:
+    return [layout for layouts in protocol.framing.alternatives.values() for layout in layouts]
+
+
+def skips_of(layout: FrameLayout) -> bool:
+    """Some checksum of the layout covers a span that leaves out elements (`skip`)."""
+    return any(e.checksum is not None and e.checksum.skips for e in layout.elements)
 
 
 def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
@@ -507,6 +522,8 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
                 lines.append(f"    if (f[{offset + j}u] != 0x{byte:02x}u) {{ return {P}__NONE; }} /* {e.name} */")
         elif e.role == "command":
             code = f"(({value}) & {flag}UL) != 0u ? {P}__ERROR_CODE : (long)({value})" if flag else f"(long)({value})"
+            if layout.error:  # an error header's layout (`error_value`): the refused request's code
+                code = f"{P}__ERROR_CODE"
             lines.append(f"    code = {code}; /* {e.name} */")
             lines.append(
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
@@ -535,6 +552,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             f"      return {sum(sizes) - counted}L + counted; }}",
         ]
     else:
+        lines += terminated_probe(ctx, direction, k, layout, sum(sizes))
         lines += [
             f"    {{ long size = {p}__content_size({P}_{direction.name}, code, f + {offset}u, avail - {offset}u);",
             "      if (size < 0) { return size; }",
@@ -543,6 +561,43 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
         ]
     lines += ["}", ""]
     return "\n".join(lines)
+
+
+def terminated_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout, overhead: int) -> list[str]:
+    """The probe's lines for a frame ended by its trailer with nothing else to size it (no length, no transform, a
+    code with no size rule): the first occurrence of the trailer at which the frame checks (this layout's unwrap:
+    constants, values, checksums), so a trailer byte inside the content or a checksum does not end it; wait while
+    none has come, no frame past the largest content (runtime/framing.py _terminated). [] for other layouts."""
+    p, P = ctx.p, ctx.P
+    last = layout.elements[-1]
+    if len(layout.elements) < 2 or last.role not in ("header", "trailer", "constant"):
+        return []
+    ruled = [
+        code_key(P, code)
+        for code, users in messages_by_code(ctx.protocol, direction).items()
+        if len(users) == 1 and size_terms(users[0].fields) is not None
+    ]
+    if len(ruled) == len(messages_by_code(ctx.protocol, direction)):
+        return []  # every code's content is sized by its own leading fields
+    trailer = last.constant
+    found = " && ".join(f"f[i + {j}u] == 0x{byte:02x}u" for j, byte in enumerate(trailer))
+    unwrap = f"{p}__unwrap_{direction.value}_{k}(f, i + {len(trailer)}u, &c, v, &content, &clen"
+    unwrap += ", 0)" if length_byte.applies(ctx.protocol) else ")"
+    return [
+        f"    if ({' && '.join(f'code != {key}' for key in ruled) or '1'}) {{",
+        "        /* no size rule: the frame ends at the first trailer at which it checks */",
+        f"        uint32_t c, v[{P}__MAX_ELEMENTS];",
+        "        const uint8_t *content;",
+        "        size_t clen, i;",
+        f"        for (i = {overhead - len(trailer)}u + low; i + {len(trailer)}u <= avail; i++) {{",
+        f"            if ({found}) {{",
+        f"                if (bounded && i + {len(trailer)}u > {overhead}u + high) {{ return {P}__NONE; }}",
+        f"                if ({unwrap} == {P}_OK) {{ return (long)(i + {len(trailer)}u); }}",
+        "            }",
+        "        }",
+        f"        return bounded && avail > {overhead}u + high ? {P}__NONE : {P}__WAIT;",
+        "    }",
+    ]
 
 
 def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
@@ -641,6 +696,25 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
             value = _wire_value(start[i], sizes[i], e.endian == ">")
+            if e.checksum.skips:  # its span less the elements it leaves out, gathered (runtime Layout._covered)
+                left = {names.index(name) for name in e.checksum.skips}
+                runs: list[tuple[int, int]] = []
+                for j in range(a, b + 1):
+                    if j not in left and runs and runs[-1][1] == j - 1:
+                        runs[-1] = (runs[-1][0], j)
+                    elif j not in left:
+                        runs.append((j, j))
+                lines += [
+                    f"    {{ uint8_t covered[{P}_MAX_FRAME]; /* {e.name}: {', '.join(e.checksum.skips)} left out */",
+                    "      size_t m = 0u, i;",
+                    f"      if (n > {P}_MAX_FRAME) {{ return {P}_E_CAPACITY; }}",
+                ]
+                for x, y in runs:
+                    lines.append(f"      for (i = {at(start[x])}; i < {at(end[y])}; i++) {{ covered[m++] = f[i]; }}")
+                lines.append(
+                    f"      if ({p}__check({check}u, covered, m) != ({value})) {{ return {P}_E_CHECKSUM; }} }}"
+                )
+                continue
             lines.append(
                 f"    if ({p}__check({check}u, f + {at(start[a])}, {span(a, b)}) != ({value})) {{ "
                 f"return {P}_E_CHECKSUM; }} /* {e.name} */"
@@ -685,6 +759,7 @@ def source(ctx: Ctx) -> str:
     waits = False  # the classic parser waits for a prefix in some direction
     both = len(directions(protocol)) == len(DIRECTIONS)  # every direction the API lets through has its cases
     probed = unwrapped = both  # every layout's case there: nothing after the switch is reached
+    terminated: list[tuple[Direction, int]] = []  # layouts whose probe calls their unwrap (ended by a trailer)
     for d in directions(protocol):
         alternatives = protocol.framing.alternatives[d]
         fewest = min(_prefix(ctx, a) for a in alternatives)
@@ -702,6 +777,8 @@ def source(ctx: Ctx) -> str:
                 )
             if layout.transparency is None:
                 probes.append(straight_probe(ctx, d, k, layout))
+                if "__unwrap_" in probes[-1]:  # ended by its trailer: the probe calls the unwrap defined below
+                    terminated.append((d, k))
                 prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail);")
         # each direction's headers as a table by layout (NULL, 0: none); k is below the direction's count
         heads = [f"{p}__h_{d.value}_{k}" if layout.header else "NULL" for k, layout in enumerate(alternatives)]
@@ -759,6 +836,10 @@ def source(ctx: Ctx) -> str:
     any_stuffed = any(stuffed.values())
     # __get: read by the engine's code for stuffed layouts and by the content code that asks for it
     engine = HEAD + (GET if any_stuffed or "get" in ctx.helpers else "") + TAIL
+    engine = with_skips(engine, any(skips_of(layout) for layout in every_layout(protocol)))
+    engine = with_inner_lengths(
+        engine, any(plain_span(layout) for layout in every_layout(protocol)), transform_prefixes(protocol, p)
+    )
     engine = engine.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
     engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks
@@ -792,6 +873,8 @@ def source(ctx: Ctx) -> str:
             key = code_key(P, code)
             command = protocol.command(users[0].command)
             body = []
+            if code == ERROR_CODE and protocol.error_reply is not None and not protocol.error_reply.flag:
+                continue  # told by its header (`error_value`): decode_expect decodes it ({p}__decode_refused)
             if code == ERROR_CODE and protocol.error_reply is not None:
                 error = protocol.error_reply
                 element = error_element(protocol, users[0])
@@ -843,6 +926,17 @@ def source(ctx: Ctx) -> str:
     # encoders: public per-message functions
     pub_encoders: list[str] = []
     opt = optional.has_optional(ctx)
+    # error replies told by their header (`error_value`): sent in the error layouts alone, every other message in
+    # the others; decoded from a frame of an error layout
+    refusals = [(d, k) for d in directions(protocol) for k, a in enumerate(protocol.framing.alternatives[d]) if a.error]
+    refusing_param = "int refusing, " if refusals else ""
+    skip_refusal = (
+        f"\n        if ((L->error_flag == {ERROR_LAYOUT}UL) != (refusing != 0)) {{ /* an error header's layout */"
+        "\n            continue;\n        }"
+        if refusals
+        else ""
+    )
+    refused_fn, refused_call = refused_decoder(ctx, refusals)
     xargs = "present, extras, " if opt else ""
     for m in msgs:
         mid = msg_id(m)
@@ -853,7 +947,9 @@ def source(ctx: Ctx) -> str:
         xdecls, vchecks = optional.encode_lines(ctx, m.direction) if opt else ([], [])
         vsets = []
         element = error_element(protocol, m)
-        if element is not None and protocol.error_reply is not None:
+        if element is not None and protocol.error_reply is not None and not protocol.error_reply.flag:
+            wire_code = f"(uint32_t)m->{ident(element[0])}"  # under the error header (`error_value`)
+        elif element is not None and protocol.error_reply is not None:
             flag = protocol.error_reply.flag
             vchecks.append(f"    if ((m->{ident(element[0])} & {flag}u) != 0u) {{ return {P}_E_RANGE; }}")
             wire_code = f"((uint32_t)m->{ident(element[0])} | {flag}UL)"
@@ -884,7 +980,9 @@ def source(ctx: Ctx) -> str:
                     *vchecks,
                     *vsets,
                     *([] if values else ["    values[0] = 0u;"]),
-                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}m, "
+                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}"
+                    + (f"{int(element is not None)}, " if refusals else "")
+                    + f"m, "
                     f"{p}__enc_{mid}, buf, cap, len);",
                     "}",
                     "",
@@ -933,7 +1031,7 @@ static size_t {p}__least({p}_direction_t dir)
     no_checksums = "" if cases else "\n    (void)d;\n    (void)n;"
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     optionals = max((len(optional.elements_of(ctx, d)) for d in directions(protocol)), default=0)
-    xparams = "uint8_t present, const uint8_t *const *extras, " if opt else ""
+    xparams = ("uint8_t present, const uint8_t *const *extras, " if opt else "") + refusing_param
     xdecl = "const uint8_t *const *extras, " if opt else ""
     xarg = "extras, " if opt else ""
     skip_variant = (
@@ -1043,6 +1141,12 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     probing = (
         "/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */\n"
     )
+    probing += "".join(
+        f"static int {p}__unwrap_{d.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,\n"
+        "                                 const uint8_t **content, size_t *clen"
+        + (", int sized);\n" if length_byte.applies(protocol) else ");\n")
+        for d, k in terminated
+    )
     no_layouts = f"""
     if (count == 0u) {{ /* a direction the protocol has no frames for */
         return {P}_E_ARG;
@@ -1133,7 +1237,7 @@ static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, 
 
 {admits_fn}
 /* ---- content decoders ---- */
-{decoders}
+{decoders}{refused_fn}
 static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect, const uint8_t *c, size_t n,
                                 const uint32_t *values, {xdecl}{p}_msg_t *out)
 {{
@@ -1181,7 +1285,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
-    }}{find_extras}
+    }}{find_extras}{refused_call}
     r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values,
                             {xarg}out);
     if (r != {P}_OK) {{
@@ -1215,7 +1319,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = {P}__T(L) ? L->t_first : 0u;{skip_variant}
+        uint8_t from = {P}__T(L) ? L->t_first : 0u;{skip_variant}{skip_refusal}
         for (i = from; (int)i < L->content; i++) {{
             before += L->e[i].size;
         }}
@@ -1601,6 +1705,50 @@ const char *{p}_result_name(int result)
 
 
 ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY
+ERROR_LAYOUT = 0xFFFFFFFF  # a layout's error_flag in the tables: an error header's layout (`error_value`)
+
+
+def refused_decoder(ctx: Ctx, refusals: list[tuple[Direction, int]]) -> tuple[str, str]:
+    """Where error replies are told by their header (`error_value`): the function that decodes a frame of an error
+    layout as the error reply (the refused request's code from the command element), and decode_expect's call of it
+    (runtime/framing.py: a frame of a layout with `error` is the error reply)."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    if not refusals:
+        return "", ""
+    m = next(m for m in messages(protocol) if m.error_reply)
+    element = error_element(protocol, m)
+    assert element is not None
+    values = value_elements(protocol, m.direction)
+    xparam = "const uint8_t *const *extras, " if optional.has_optional(ctx) else ""
+    function = "\n".join(
+        [
+            "/* An error reply told by its header (`error_value`): the refused code in the command element. */",
+            f"static int {p}__decode_refused(uint32_t code, const uint8_t *c, size_t n, const uint32_t *values,",
+            f"                              {xparam}{p}_msg_t *out)",
+            "{",
+            "    int r;",
+            "    (void)values;",
+            f"    out->u.{msg_id(m)}.{ident(element[0])} = ({_ctype_of(element[1])})code;",
+            f"    {dec_call(ctx, m, values)}",
+            "}",
+            "",
+        ]
+    )
+    test = " || ".join(f"(dir == {P}_{d.name} && k == {k}u)" for d, k in refusals)
+    xarg = "extras, " if optional.has_optional(ctx) else ""
+    call = "\n".join(
+        [
+            "",
+            f"    if ({test}) {{ /* an error header's layout: the error reply */",
+            f"        r = {p}__decode_refused(code, c, clen, values, {xarg}out);",
+            f"        if (r != {P}_OK) {{",
+            f"            out->kind = {P}_KIND_NONE;",
+            "        }",
+            "        return r;",
+            "    }",
+        ]
+    )
+    return function, call
 
 
 def switch_cases(cases: list[str], closed: bool, otherwise: str) -> str:

@@ -38,6 +38,19 @@ def method(protocol: Protocol, p: str, transform: Transform | None) -> int:
     return 2 + [c.rewrite for c in _used(protocol, p)].index(code.rewrite)
 
 
+def prefixes(protocol: Protocol, p: str) -> bool:
+    """Some layout's length inside its span counts plain bytes under a transform of its own C (not substitution):
+    the engine reads it through that transform's plain_prefix."""
+    from serialspec.backends.c.emit import plain_span
+
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            t = layout.transparency
+            if t is not None and not isinstance(t.transform, Replace) and plain_span(layout):
+                return True
+    return False
+
+
 def dispatch(protocol: Protocol, p: str, P: str) -> str:
     """The transforms' C and the engine's two calls into them: p__transform (rewrite the span, either way) and, for
     the parser, p__span_end (where the span ends on the wire: -1 where the transform cannot tell)."""
@@ -48,6 +61,25 @@ def dispatch(protocol: Protocol, p: str, P: str) -> str:
     span_end = _switch(ends, ("method", "b", "start", "avail"), f"{P}__NONE")
     codes = "".join(c.code + "\n" for c in used)
     span_codes = "".join(c.span_code + "\n" for c in used if c.span_end)
+    prefix = ""
+    if prefixes(protocol, p):
+        calls = [
+            (i + 2, f"{c.plain_prefix}(b, start, avail, count, from, dst)")
+            for i, c in enumerate(used)
+            if c.plain_prefix
+        ]
+        names = ("method", "b", "start", "avail", "count", "from", "dst")
+        prefix_codes = "".join(c.prefix_code + "\n" for c in used if c.plain_prefix)
+        prefix = f"""
+#if {P}_ENABLE_PARSER && {P}__STUFFED
+{prefix_codes}/* The wire bytes that give a span's first `count` plain bytes, by its transform (has_t 2..). */
+static long {p}__transform_prefix(uint8_t method, const uint8_t *b, size_t start, size_t avail, size_t count,
+                                  size_t from, uint8_t *dst)
+{{
+{_switch(calls, names, f"{P}__NONE")}
+}}
+#endif
+"""
     return f"""{codes}/* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
 static int {p}__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
                           const uint8_t *cmp, size_t cap, size_t *out)
@@ -63,7 +95,7 @@ static long {p}__span_end(uint8_t method, const uint8_t *b, size_t start, size_t
 {span_end}
 }}
 #endif
-"""
+{prefix}"""
 
 
 def _switch(cases: list[tuple[int, str]], parameters: tuple[str, ...], otherwise: str) -> str:

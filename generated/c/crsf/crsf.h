@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "4e23c8d95df402e5b6791811e040a2f138f7f96847c90a3246e5a22d496e0954"
+#define CRSF_SPEC_SHA256 "ddd27f84d166eecba74aff98d9de097940991aca260e82902ac304e1f59e3154"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

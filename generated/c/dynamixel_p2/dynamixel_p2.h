@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "9c9515b0047b55f3a9373e21e21a36f95e268986cea84295af0a13d4623658f1"
+#define DYNAMIXEL_P2_SPEC_SHA256 "1daa6601803674e8638fe2ff6fde90477288885b541c2d881e015e3d445db880"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "bc05824507a2b97ed0c3e7b70bc3aa455e55aee705a57f829af49017ba1eaa56"
+#define FEETECH_SMS_SPEC_SHA256 "37a9759a1cd4e548d735597c3aa7097623a1f3beed2ead3d42230f5391a15233"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

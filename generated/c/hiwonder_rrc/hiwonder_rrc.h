@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "499296f4a990bfb97dd94d3871d8af47f1204d7bf93c0e8c0b45062ce6dba6fe"
+#define HIWONDER_RRC_SPEC_SHA256 "b56be7535b5175bb96bb200a83e807d02caeb70b8b8e2c5a00371f27026b6da9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "83705f750c0fdf5a5dd6b74343ffc67a73953133d627ec18cc79ea4aede70456"
+#define MAVLINK_COMMON_SPEC_SHA256 "988c8d04c2fccb8c861f7adeb7bdf59456d7971e8e2d7d8d058c81aac3796f31"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

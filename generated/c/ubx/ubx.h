@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "d9182d951a01f9bbfa80af95345bb13521253dc66d93c23603d015083fbb5535"
+#define UBX_SPEC_SHA256 "3910e8ddc7d9d4f01885049f23c8aa2881750fd40ebff9caab0a17cb5a2412a5"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

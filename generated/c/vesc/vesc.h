@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "f67efcf7f8f7918db222c3c4ae1af9eb92270cb387faebf80073dbb7ad9542b7"
+#define VESC_SPEC_SHA256 "6837ff797afd1dfbdd69ce0d340df7011d247541427fe3d3758c7f71b2b96d3a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -103,7 +103,7 @@ def refuse_by_command(protocol: Protocol) -> None:
 
 def refuse_code_forms(protocol: Protocol) -> None:
     """Unsupported for a layout whose frames carry an expression of the command's code (`code:`) or a headerless
-    layout beside headed ones, in targets that do not do them yet (the C decoder, the Wireshark dissector)."""
+    layout beside headed ones, in a target that does not do them (the C decoder)."""
     layouts = [(layout, len(found)) for found in protocol.framing.alternatives.values() for layout in found]
     for layout, _ in layouts:
         if any(e.code for e in layout.elements if e.role == "command"):

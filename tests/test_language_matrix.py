@@ -779,6 +779,38 @@ CASES[MIXED] = Case(
 C_REFUSES[MIXED] = WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
 
 
+# The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a
+# header, its code plain, tried last; one after a header, its code an expression of the command's (`code:`)
+FORMS = "frame: layouts, one headerless, one sending its code as an expression (`code:`)"
+CASES[FORMS] = Case(
+    {"v": "u16"},
+    {"v": "u16", "on": {"type": "u8", "range": [0, 1]}},
+    {
+        "layouts": {
+            "compact": {
+                "elements": {
+                    "code": {"role": "command", "type": "u8"},
+                    "length": {"role": "length", "type": "u8"},
+                    "content": {"role": "content"},
+                    "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+                }
+            },
+            "framed": {
+                "elements": {
+                    "start": {"role": "header", "value": "AA"},
+                    "code": {"role": "command", "type": "u8", "code": "code | 0x80"},
+                    "length": {"role": "length", "type": "u8"},
+                    "content": {"role": "content"},
+                    "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+                }
+            },
+        }
+    },
+    commands={"other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"fields": {"b": "i16"}}}},
+)
+C_REFUSES[FORMS] = "an expression of the code (`code:`"
+
+
 # `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
 CASES["device: sends every an expression (a rate)"] = Case(
     {"v": "u16"},

@@ -4,7 +4,8 @@ transfers, `maestro` is unrelated, `pololu-maestro` does not exist), so the peer
 Serial Servo Commands): its printed bytes are our golden frames, and a raw pyserial session sending the guide's
 bytes drives `serialspec sim`, as does our client. A 14-bit value sent as two 7-bit bytes is one field
 (`encoding: seven_bit`). The Pololu protocol form of the same commands (0xAA, device number, command with bit 7
-cleared) is a strict xfail, a language gap. Replies without a code, of different sizes, in a plain
+cleared) is a strict xfail: its command code and headerless layout are in the language (tests/test_code_forms.py),
+its device number, which the compact form does not carry, is not. Replies without a code, of different sizes, in a plain
 `framing.elements` spec are taken by the stream parser as the reply awaited (a bug once; the spec names one layout
 from every command, which works too)."""
 
@@ -188,10 +189,10 @@ commands:
 @pytest.mark.xfail(
     strict=True,
     reason="language gap: the Pololu protocol form sends the same commands after 0xAA and a device number with bit 7 "
-    "of the command cleared (AA 0C 04 02 70 2E for 84 02 70 2E); the spec needs a command element whose wire value "
-    'is an expression of the command\'s code in one layout (`code: "code & 0x7F"`, as `reply_code` is for replies) '
-    "and a headerless layout beside one with a header; the loader says `unknown key 'code'` and `alternative request "
-    "layouts must start with different headers`, so a spec can give one form only",
+    'of the command cleared (AA 0C 04 02 70 2E for 84 02 70 2E). The command element\'s `code: "code & 0x7F"` and a '
+    "headerless layout beside one with a header are in the language now (tests/test_code_forms.py reads both forms "
+    "without the device number); what is left is a frame value (the device number) that one layout carries and the "
+    "other does not: the loader says `alternative layouts must carry the same address/status`",
 )
 def test_the_pololu_protocol_form(tmp_path: Path) -> None:
     path = tmp_path / "maestro_pololu.yaml"

@@ -453,3 +453,41 @@ def test_tshark_verifies_every_checksum_algorithm(tmp_path: Path) -> None:
         for shape in SHAPES
     ]
     through_tshark(tmp_path, specs, corrupt=True)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_reads_both_forms_of_the_same_commands(tmp_path: Path) -> None:
+    """A headerless layout beside one whose command element sends `code & 0x7F` after a header (the Maestro's
+    compact and Pololu forms, tests/test_code_forms.py): each frame, alone or all in one packet, shown as decoded."""
+    assert TSHARK is not None
+    from serialspec.lang import load_protocol
+    from test_code_forms import FRAMES, SPEC, write
+
+    path = write(tmp_path, SPEC)
+    protocol = load_protocol(path)
+    run(*SERIALSPEC, "generate", str(path), "--target", "wireshark", "--out", str(tmp_path / "out"))
+    frames = [bytes.fromhex(printed) for printed, _ in FRAMES]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["decode", str(path), "--json", "--direction", "request", *(f.hex(" ") for f in frames)]) == 0
+    results = [json.loads(line) for line in out.getvalue().splitlines()]
+    lines = [f"# serialspec capture: {protocol.name}"]
+    lines += [f"2026-11-25T10:00:00.000000+00:00 request {data.hex(' ')}" for data in [*frames, b"".join(frames)]]
+    (tmp_path / "forms.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    run(*SERIALSPEC, "export", str(tmp_path / "forms.capture"), "--pcap", str(tmp_path / "forms.pcap"))
+    script = f"lua_script:{tmp_path / 'out' / protocol.name / f'{protocol.name}.lua'}"
+    xml = run(TSHARK, "-X", script, "-r", str(tmp_path / "forms.pcap"), "-T", "pdml")
+    trees = [
+        proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") == "two_forms"
+    ]
+    assert len(trees) == 2 * len(results)
+    for tree, expected in zip(trees, results * 2, strict=True):
+        seen = shown(protocol, tree)
+        assert seen == {key: expected[key] for key in seen}, expected["hex"]
+    bad = tmp_path / "bad.capture"  # AA before a code the Pololu form does not send (bit 7 set): no Pololu frame
+    bad.write_text(f"# serialspec capture: {protocol.name}\n2026-11-25T10:00:00.000000+00:00 request aa 84 02 70 2e\n")
+    run(*SERIALSPEC, "export", str(bad), "--pcap", str(tmp_path / "bad.pcap"))
+    said = run(TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-V")
+    assert "Bytes outside any frame: aa" in said and "request set_target" in said, said

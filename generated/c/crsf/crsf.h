@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "d24aaee8db194db7e3dd6a039a5db5254975b6e0e7ee9c0b6739d864b72c07d2"
+#define CRSF_SPEC_SHA256 "1e276b5f5c482e15446130f97279ad76b2e3986e82034c29e7a469a68b3ebb38"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "91472832208303a534f7b1a0a3054df48204f30d9d985e49b5a945aba63f83fc"
+#define DYNAMIXEL_P2_SPEC_SHA256 "6460d66e0546db67eaa4cd08ea0986ac9cacae9b574ae4a4438eff803d1fdca9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

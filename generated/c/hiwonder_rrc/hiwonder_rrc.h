@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "60304d613671e67aaf875409f103ef00b1374953fe4eaa31018bfe9762e7f03b"
+#define HIWONDER_RRC_SPEC_SHA256 "697c2d1766eb3a462a6213ce916ee0c04df4adbf74b46a831a2ea82039899192"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "e31b43aaa6a38899a04df84915307f5d400ccfb5ba24ec4ea5824c13f4917576"
+#define MAVLINK_COMMON_SPEC_SHA256 "e0bef61757e49ed91c7a064ca3439261319e0f2026bf85d8aae22c28ceafa286"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "4151ef87ea20c7f5c6ac4bec207a9ae6228e8671711ed008382752d32dcc78b7"
+#define VESC_SPEC_SHA256 "ea26683a92aba93cd102c5ba5b8d1289f14400aed125cd99bee53c6d89007f4a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

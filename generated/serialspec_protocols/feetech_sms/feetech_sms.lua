@@ -1040,7 +1040,10 @@ local function frame_size(direction, layout, data, pos)
     if element.constant then
       if bytes ~= element.constant then return nil end
     elseif element.role == "command" then
-      entry = entry_of(direction, unsigned(bytes, element.big), layout)
+      local code = unsigned(bytes, element.big)
+      if element.wire then code = element.wire[code] end -- sent as an expression of the code (`code:`)
+      if code == nil then return nil end
+      entry = entry_of(direction, code, layout)
       if entry == nil then return nil end
     elseif element.role == "address" or element.role == "status" or element.role == "value" then
       if not plausible(element, unsigned(bytes, element.big)) then return nil end
@@ -1200,7 +1203,13 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
   -- the command and the message (the command may lie in the stuffed part: read here, after unstuffing)
   local code, content_index = nil, nil
   for index, element in ipairs(elements) do
-    if element.role == "command" then code = unsigned(plain[index], element.big) end
+    if element.role == "command" then
+      code = unsigned(plain[index], element.big)
+      if element.wire and element.wire[code] == nil then
+        error(string.format("%s = 0x%02x is no code of this frame", element.name, code), 0)
+      end
+      if element.wire then code = element.wire[code] end
+    end
     if element.role == "content" then content_index = index end
   end
   entry = entry or entry_of(direction, code, layout)

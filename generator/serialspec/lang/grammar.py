@@ -844,6 +844,14 @@ FRAME_ELEMENT = Obj(
             "a reply by it, the simulator answers with it and clients match replies as usual (by command).",
             example="code | 0x40",
         ),
+        "code": Str(
+            "command: the code this layout's frames carry, as an expression of the command's `code`, where one "
+            "protocol sends the same commands in two frame forms (the Pololu Maestro's Pololu protocol: `AA`, a "
+            "device number, then the command with bit 7 cleared, `code & 0x7F`; its compact protocol sends the "
+            "code itself). Computed when the spec is read: no two commands may carry the same code in the layout, "
+            "encode writes it, decode and the stream parser read the command by it.",
+            example="code & 0x7F",
+        ),
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
             "it the bytes as sent); default the content only.",
@@ -969,7 +977,14 @@ FRAMING = Obj(
             ),
             "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
             "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length). They all have a command "
-            "element or none, unless each command names its layout (`layout:`).",
+            "element or none, unless each command names its layout (`layout:`). One layout may have no header if "
+            "it starts with its command element: it takes every frame that starts with no other layout's header, "
+            "and no code it sends may start as a header does (checked when the spec is read), so a frame is told "
+            "by its first bytes alone. Layouts that are the same in one direction are one layout there. The Pololu "
+            "Maestro's two forms of the same commands: `compact: {elements: {command: {role: command}, content: "
+            "{role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, value: AA}, command: "
+            '{role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 2E): both decode to '
+            "Set Target, a frame starting AA is the Pololu form (no command code is AA).",
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),

@@ -61,6 +61,7 @@ class Element:
     flag: int = -1  # optional: the index of the element whose bit `mask` says it is sent
     mask: int = 0
     need: tuple[int, int] = (0, 0)  # value (in a variant): (mask, bits) the value must have under the mask
+    wire: tuple[tuple[int, int], ...] = ()  # command: (code, code sent) where the layout sends an expression of it
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -98,6 +99,10 @@ class Layout:
         object.__setattr__(self, "length", kinds.index("length") if "length" in kinds else None)
         optional = [i for i, k in enumerate(kinds) if k == "optional"]
         object.__setattr__(self, "_found", self._variants(optional[0]) if optional else (self,))
+        # a command element whose frames carry an expression of the code (`code:`): the codes sent, both ways
+        wire = self.elements[self.command].wire if self.command is not None else ()
+        object.__setattr__(self, "to_wire", dict(wire))
+        object.__setattr__(self, "from_wire", {sent: code for code, sent in wire})
         # How unwrap cuts a frame, worked out once: fixed slices before and after the variable part, then the
         # variable part's own elements (fixed but for the content); the checks by kind, in element order.
         first, last = self._inner()
@@ -293,6 +298,11 @@ class Layout:
         if self.content >= 0:
             plain[self.content] = content
         if self.command is not None:
+            to_wire: dict[int, int] = self.to_wire  # type: ignore[attr-defined]
+            if to_wire:
+                if code not in to_wire:
+                    raise EncodeError(f"code {code} is not sent in the {self.name} frame")
+                code = to_wire[code]
             plain[self.command] = _pack(elements[self.command], code or 0)
         for index, value in zip(self.values, values, strict=True):
             plain[index] = _pack(elements[index], value)
@@ -408,6 +418,11 @@ class Layout:
                 raise DecodeError(f"{element.name} is {data.hex(' ')}, expected {element.constant.hex(' ')}")
         command = self.command
         code = elements[command].unpack(plain[command]) if command is not None else None
+        from_wire: dict[int, int] = self.from_wire  # type: ignore[attr-defined]
+        if from_wire and code is not None:
+            if code not in from_wire:
+                raise DecodeError(f"{elements[command or 0].name} = {code:#04x} is no code of the {self.name} frame")
+            code = from_wire[code]
         values = tuple(elements[i].unpack(plain[i]) for i in self.values)
         for i, value in zip(self.values, values, strict=True):
             if not elements[i].plausible(value):  # as the stream parser, which sees no frame there
@@ -440,7 +455,10 @@ def _code_at(layout: Layout, frame: bytes) -> int | None:
         return None
     element = layout.elements[layout.command]
     data = frame[offset : offset + element.size]
-    return element.unpack(data) if len(data) == element.size else None
+    if len(data) != element.size:
+        return None
+    from_wire: dict[int, int] = layout.from_wire  # type: ignore[attr-defined]
+    return from_wire.get(element.unpack(data), -1) if from_wire else element.unpack(data)
 
 
 def _class_name(cls: Any) -> Any:
@@ -663,9 +681,10 @@ class FrameCodec:
         raise problem
 
     def layout_of(self, frame: bytes) -> Layout:
+        """The layout whose header the frame starts with; the one headerless layout beside them takes the rest."""
         if len(self.layouts) == 1:
             return self.layouts[0]
-        for layout in self.layouts:
+        for layout in sorted(self.layouts, key=lambda each: not each.header):
             if frame.startswith(layout.header):
                 return layout
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
@@ -729,6 +748,11 @@ class FrameCodec:
                     return -1
             elif kind == "command":
                 value = int.from_bytes(data, element.endian)
+                if element.wire:
+                    from_wire: dict[int, int] = layout.from_wire  # type: ignore[attr-defined]
+                    if value not in from_wire:
+                        return -1
+                    value = from_wire[value]
                 code = ERROR_REPLY if layout.error or value & self.error_flag else value
                 if code not in self.content_sizes or (layout.codes is not None and code not in layout.codes):
                     return -1
@@ -784,13 +808,15 @@ class FrameCodec:
             if place is None:
                 self._trailing_cache[key] = None
             else:
+                to_wire: dict[int, int] = layout.to_wire  # type: ignore[attr-defined]
                 sizes = sorted(
-                    (layout.overhead + low, code)
+                    (layout.overhead + low, to_wire.get(code, code))
                     for code, (low, high) in self.content_sizes.items()
                     if isinstance(code, int)
                     and code >= 0
                     and low == high
                     and (layout.codes is None or code in layout.codes)
+                    and (not to_wire or code in to_wire)
                 )
                 element = layout.elements[layout.command or 0]
                 self._trailing_cache[key] = (*place, element.endian, tuple(sizes))
@@ -844,12 +870,14 @@ class FrameCodec:
                 allowed = [[byte] for byte in element.constant]
             elif element.kind == "command" and stop == first + 1:
                 codes = self.content_sizes
+                from_wire: dict[int, int] = layout.from_wire  # type: ignore[attr-defined]
                 allowed = [
                     [
                         v
                         for v in range(256)
-                        if (ERROR_REPLY if layout.error or v & self.error_flag else v) in codes
-                        and (layout.codes is None or v in layout.codes)
+                        if (not from_wire or v in from_wire)
+                        and (ERROR_REPLY if layout.error or v & self.error_flag else from_wire.get(v, v)) in codes
+                        and (layout.codes is None or from_wire.get(v, v) in layout.codes)
                     ]
                 ]
             elif element.kind == "value" and stop == first + 1:
@@ -876,8 +904,10 @@ class FrameCodec:
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         if plan["probe_inner"] is not None:  # sized by reading into the transformed span: probe() decides
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
-        if layout.codes is not None or layout.content < 0 or self._trailing(layout) is not None:
-            # layouts chosen by command, fixed frames, a command element after the content: probe()
+        wire = layout.command is not None and layout.elements[layout.command].wire
+        if layout.codes is not None or layout.content < 0 or self._trailing(layout) is not None or wire:
+            # layouts chosen by command, fixed frames, a command element after the content, codes sent as an
+            # expression of them: probe()
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
         need = max((stop for _, _, stop in head), default=0)

@@ -53,6 +53,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         request=element.checksum.from_request if element.checksum is not None else (),
         flag=layout.index(element.present_if[0]) if element.present_if[0] else -1,
         mask=element.present_if[1],
+        wire=element.wire,
     )
 
 
@@ -98,6 +99,18 @@ def refuse_by_command(protocol: Protocol) -> None:
         raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
     if protocol.framing.by_request(Direction.RESPONSE):
         raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
+
+
+def refuse_code_forms(protocol: Protocol) -> None:
+    """Unsupported for a layout whose frames carry an expression of the command's code (`code:`) or a headerless
+    layout beside headed ones, in a target that does not do them (the C decoder)."""
+    layouts = [(layout, len(found)) for found in protocol.framing.alternatives.values() for layout in found]
+    for layout, _ in layouts:
+        if any(e.code for e in layout.elements if e.role == "command"):
+            raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
+    for layout, alternatives in layouts:
+        if alternatives > 1 and not layout.header and not protocol.framing.by_command:
+            raise Unsupported(f"a layout without a header beside layouts with one (layout {layout.name})")
 
 
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:

@@ -468,6 +468,12 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         elif e.role == "command" and layout.direction == Direction.RESPONSE and protocol.framing.reply_code:
             computed = f"the code of the request it answers, as `{protocol.framing.reply_code}`"
             description = ". ".join(p for p in (computed, e.description) if p)
+        elif e.role == "command" and e.code:
+            codes = ", ".join(f"{code:#04x} as {sent:#04x}" for code, sent in e.wire)
+            computed = f"each command's code as `{e.code}`" + (f" ({codes})" if codes else "")
+            if not layout.header:
+                computed += "; this layout has no header: it takes every frame that starts with no other's header"
+            description = ". ".join(p for p in (computed, e.description) if p)
         elif e.sequence:
             low, high = number(e.minimum), number(e.maximum)
             counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"

@@ -139,7 +139,9 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
     # a layout with optional elements (`present_if`) as the engine's variants: one per choice of them sent or not,
     # told apart by their flag bits like alternative layouts by their constants
-    variants = [(layout, variant) for layout in layouts for variant in runtime_layout(layout).variants]
+    # (a layout without a header beside ones with a header is tried last: it takes the frames no header starts)
+    ordered = sorted(layouts, key=lambda layout: not layout.header) if len(layouts) > 1 else layouts
+    variants = [(layout, variant) for layout in ordered for variant in runtime_layout(layout).variants]
     result: dict[str, Any] = {"layouts": [_layout(layout, variant) for layout, variant in variants], "codes": codes}
     if protocol.error_reply is not None:
         result["error_flag"] = protocol.error_reply.flag
@@ -168,6 +170,8 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
             if element.broadcast is not None:
                 item["broadcast"] = element.broadcast
             item.update(_scalar_extras(element.flags, element.bits, None))
+        if element.wire:  # the codes sent as an expression of them (`code:`): each command's code by the one sent
+            item["wire"] = {sent: code for code, sent in element.wire}
         if element.role == "length":
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["adds"] = element.adds

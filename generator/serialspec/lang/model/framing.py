@@ -53,6 +53,10 @@ class FrameElement:
     sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
     truncate: bool = False  # content: trailing zero bytes dropped on encode, padded back on decode (MAVLink v2)
     present_if: tuple[str, int] = ("", 0)  # optional: (flag element, mask): sent when flag & mask (MAVLink signature)
+    # command: the code this layout's frames carry, as an expression of the command's `code` (`code & 0x7F`), as
+    # shown; `wire` holds each command's (code, code sent), computed when the commands are read
+    code: str = ""
+    wire: tuple[tuple[int, int], ...] = ()
 
     @property
     def fixed(self) -> bool:

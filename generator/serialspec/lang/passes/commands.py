@@ -14,6 +14,7 @@ from serialspec.lang.model import (
     Command,
     Direction,
     Field,
+    FrameLayout,
     Framing,
     Message,
     OptionalWhen,
@@ -49,6 +50,7 @@ class Commands(FieldResolver):
                 self.ctx.commands.append(command)
         if self.ctx.framing:
             self.ctx.commands[:] = self.reply_codes(self.ctx.commands, self.ctx.framing)
+            self.ctx.framing = self.wire_codes(self.ctx.commands, self.ctx.framing)
             self.check_codes(self.ctx.commands, self.ctx.framing)
             self.check_layouts(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
@@ -127,6 +129,95 @@ class Commands(FieldResolver):
                         )
             resolved.append(command)
         return resolved
+
+    def wire_codes(self, commands: list[Command], framing: Framing) -> Framing:
+        """The command element's `code:` in a layout: each command's code in that layout's frames, computed from
+        its code; two commands may not share one, and no code of a layout without a header may start as another
+        layout's header does (a frame is told by its header; the headerless layout takes the rest)."""
+        alternatives = {}
+        for direction, layouts in framing.alternatives.items():
+            alternatives[direction] = tuple(self.layout_codes(commands, layout, direction) for layout in layouts)
+            headers = [(layout.name, layout.header) for layout in layouts if layout.header]
+            for layout in alternatives[direction]:
+                if not layout.header and headers and layout.elements and layout.elements[0].role == "command":
+                    self.check_bare(commands, layout, direction, headers)
+        return replace(framing, alternatives=alternatives, layouts={d: found[0] for d, found in alternatives.items()})
+
+    def sent(self, commands: list[Command], direction: Direction) -> list[tuple[Command, int]]:
+        """The commands with frames in `direction`, with the code those frames carry."""
+        found = []
+        for command in commands:
+            code = command.wire_code(direction)
+            sends = any(m.direction == direction for m in command.messages())
+            if isinstance(code, int) and not isinstance(code, bool) and sends:
+                found.append((command, code))
+        return found
+
+    def layout_codes(self, commands: list[Command], layout: FrameLayout, direction: Direction) -> FrameLayout:
+        index = next((i for i, e in enumerate(layout.elements) if e.role == "command"), None)
+        if index is None or not layout.elements[index].code:
+            return layout
+        element = layout.elements[index]
+        place: Path = ("framing", "layouts", layout.name) if layout.name else ("framing",)
+        where: Path = (*place, "elements", element.name, "code")
+        try:
+            expr = expression.parse(element.code)
+        except expression.ExpressionError as exc:
+            self.error(where, str(exc))
+            return layout
+        if set(expression.names(expr)) != {"code"}:
+            self.error(where, "an expression of `code` (the command's code), e.g. `code & 0x7F`")
+            return layout
+        assert element.type is not None
+        low, high = int(element.type.minimum), int(element.type.maximum)
+        pairs: list[tuple[int, int]] = []
+        taken: dict[int, str] = {}
+        for command, code in self.sent(commands, direction):
+            try:
+                wire = expression.evaluate(expr, {"code": code})
+            except (ZeroDivisionError, ValueError) as exc:
+                self.error(
+                    ("commands", command.name, "code"), f"its code in layout {layout.name} ({element.code}): {exc}"
+                )
+                continue
+            if not low <= wire <= high:
+                self.error(
+                    ("commands", command.name, "code"),
+                    f"its code in layout {layout.name}, {wire} ({element.code}), does not fit the "
+                    f"{element.type.name} command element ({low}..{high})",
+                )
+            elif wire in taken and taken[wire] != command.name:
+                self.error(
+                    ("commands", command.name, "code"),
+                    f"its code in layout {layout.name}, {wire:#04x} ({element.code}), is {taken[wire]}'s too: "
+                    "a frame could not tell them apart",
+                )
+            else:
+                taken[wire] = command.name
+                pairs.append((code, wire))
+        elements = list(layout.elements)
+        elements[index] = replace(element, wire=tuple(sorted(set(pairs))))
+        return replace(layout, elements=tuple(elements))
+
+    def check_bare(
+        self, commands: list[Command], layout: FrameLayout, direction: Direction, headers: list[tuple[str, bytes]]
+    ) -> None:
+        """No code the headerless layout sends starts as another layout's header does."""
+        element = layout.elements[0]
+        assert element.size is not None
+        to_wire = dict(element.wire)
+        for command, code in self.sent(commands, direction):
+            wire = to_wire.get(code, code)
+            if not 0 <= wire < 1 << (8 * element.size):
+                continue  # said elsewhere
+            sent = wire.to_bytes(element.size, "big" if element.endian == ">" else "little")
+            for name, header in headers:
+                if sent[: len(header)] == header[: len(sent)]:
+                    self.error(
+                        ("commands", command.name, "code"),
+                        f"its {direction.value} frame in layout {layout.name} (no header) starts {sent.hex(' ')}, "
+                        f"as layout {name}'s header {header.hex(' ')} does: a frame could not be told between them",
+                    )
 
     def check_seeds(self, framing: Framing) -> None:
         """A command's `checksum_seed` belongs to a frame with a `seed: per_command` checksum."""

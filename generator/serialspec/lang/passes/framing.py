@@ -77,13 +77,22 @@ class FramingPass(FieldResolver):
                 )
             refusing += self.error_layout(raw, alternatives[Direction.RESPONSE][-1], elements_path, by_command)
         alternatives[Direction.RESPONSE] += refusing
+        if not by_command:
+            alternatives = {d: distinct_layouts(layouts) for d, layouts in alternatives.items()}
         for direction, layouts in alternatives.items():
             if len(layouts) > 1 and not by_command:
-                headers = [layout.header for layout in layouts]
-                if not all(headers) or len(set(headers)) != len(headers):
+                headed = [layout.header for layout in layouts if layout.header]
+                bare = [layout for layout in layouts if not layout.header]
+                if (
+                    len(set(headed)) != len(headed)
+                    or len(bare) > 1
+                    or any(not layout.elements or layout.elements[0].role != "command" for layout in bare)
+                ):
                     raise self.fail(
                         (*path, "layouts"),
-                        f"alternative {direction.value} layouts must start with different headers",
+                        f"alternative {direction.value} layouts must start with different headers (one layout "
+                        "without a header may stand beside them if it starts with its command element: it takes "
+                        "the frames no header starts)",
                     )
                 values = {tuple(e.name for e in layout.value_elements) for layout in layouts}
                 if len(values) != 1:
@@ -200,6 +209,7 @@ class FramingPass(FieldResolver):
             ("from_request", "checksum"),
             ("size", "optional"),
             ("present_if", "optional"),
+            ("code", "command"),
         ):
             if key in item and role != allowed and role in ROLES:  # an unknown role is one mistake, said once
                 article = "an" if allowed[0] in "aeiou" else "a"
@@ -222,6 +232,7 @@ class FramingPass(FieldResolver):
             bits_class=bits_class,
             adds=int(item.get("adds", 0)),
             checksum=checksum,
+            code=" ".join(str(item.get("code", "")).split()),
         )
 
     def checksum(
@@ -559,6 +570,16 @@ class FramingPass(FieldResolver):
             checksums=checksums,
             classic=classic,
         )
+
+
+def distinct_layouts(layouts: list[FrameLayout]) -> list[FrameLayout]:
+    """A direction's layouts, each kept once where alternatives are the same in that direction (the Maestro's
+    compact and Pololu forms differ in requests only: their replies are one layout)."""
+    kept: list[FrameLayout] = []
+    for layout in layouts:
+        if not any(k.elements == layout.elements and k.transparency == layout.transparency for k in kept):
+            kept.append(layout)
+    return kept
 
 
 def distinct_checksum_functions(alternatives: dict[Direction, list[FrameLayout]]) -> dict[Direction, list[FrameLayout]]:

@@ -63,6 +63,8 @@ def straight(layout: Layout) -> bool:
         return False  # other transforms than substitution: the engine codes them
     if layout.variants != (layout,):
         return False  # optional elements: the engine's variants
+    if layout.command is not None and layout.elements[layout.command].wire:
+        return False  # codes sent as an expression of them (`code:`): the engine translates them
     first, last = variable_span(layout)
     if not first <= layout.content <= last:
         return False
@@ -218,6 +220,8 @@ def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayo
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
+    if len(layouts) > 1 and not all(layout.header for layout in layouts):
+        return None  # a headerless layout beside headed ones, tried last: the engine's
     if protocol.framing.requesting:
         return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(

@@ -1,0 +1,161 @@
+"""The same commands in two frame forms: a layout without a header beside one with a header, and a command element
+whose wire value is an expression of the command's code in one layout (`code: "code & 0x7F"`, the Pololu Maestro's
+Pololu protocol beside its compact protocol). A frame is told by its first bytes: a header's layout, else the
+headerless one; each mistake in such a spec is one line at its place."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pytest
+import yaml
+from conftest import generate_and_import
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from serialspec.lang import SpecErrors, load_protocol
+from serialspec.runtime.errors import DecodeError
+
+SPEC: dict[str, Any] = {
+    "protocol": "two_forms",
+    "title": "Two frame forms of the same commands",
+    "byte_order": "little",
+    "serial": {"baudrate": 9600},
+    "framing": {
+        "layouts": {
+            "compact": {
+                "elements": {
+                    "command": {"role": "command", "type": "u8", "directions": ["request"]},
+                    "content": {"role": "content"},
+                }
+            },
+            "pololu": {
+                "elements": {
+                    "start": {"role": "header", "value": "AA", "directions": ["request"]},
+                    "command": {"role": "command", "type": "u8", "directions": ["request"], "code": "code & 0x7F"},
+                    "content": {"role": "content"},
+                }
+            },
+        }
+    },
+    "commands": {
+        "set_target": {"code": 0x84, "request": {"fields": {"channel": "u8", "low": "u8", "high": "u8"}}},
+        "get_position": {"code": 0x90, "request": {"fields": {"channel": "u8"}}},
+        "go_home": {"code": 0xA2, "request": {"fields": {}}},
+    },
+}
+
+
+def write(tmp_path: Path, data: dict[str, Any]) -> Path:
+    path = tmp_path / f"{data['protocol']}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), "utf-8")
+    return path
+
+
+@pytest.fixture(scope="module")
+def forms(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    folder = tmp_path_factory.mktemp("forms")
+    return generate_and_import(write(folder, SPEC), folder / "out", "two_forms")
+
+
+def test_both_forms_decode_to_one_message(forms: ModuleType) -> None:
+    message = forms.SetTargetRequest(channel=2, low=0x70, high=0x2E)
+    assert forms.decode(bytes.fromhex("84 02 70 2e"), forms.Direction.REQUEST) == message
+    assert forms.decode(bytes.fromhex("aa 04 02 70 2e"), forms.Direction.REQUEST) == message
+    assert forms.encode(message) == bytes.fromhex("84 02 70 2e")  # the first layout that holds it
+    assert forms.decode(bytes.fromhex("aa 22"), forms.Direction.REQUEST) == forms.GoHomeRequest()
+
+
+def test_a_code_the_layout_does_not_send_is_refused_in_one_line(forms: ModuleType) -> None:
+    with pytest.raises(DecodeError, match=r"^command = 0x84 is no code of the pololu frame$"):
+        forms.decode(bytes.fromhex("aa 84 02 70 2e"), forms.Direction.REQUEST)
+    with pytest.raises(DecodeError, match="unknown command 0x04"):
+        forms.decode(bytes.fromhex("04 02 70 2e"), forms.Direction.REQUEST)
+
+
+FRAMES = [
+    ("84 02 70 2e", ("SetTargetRequest", {"channel": 2, "low": 0x70, "high": 0x2E})),
+    ("aa 04 05 01 02", ("SetTargetRequest", {"channel": 5, "low": 1, "high": 2})),
+    ("90 03", ("GetPositionRequest", {"channel": 3})),
+    ("aa 10 07", ("GetPositionRequest", {"channel": 7})),
+    ("a2", ("GoHomeRequest", {})),
+    ("aa 22", ("GoHomeRequest", {})),
+]
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    order=st.lists(st.sampled_from(range(len(FRAMES))), min_size=1, max_size=6),
+    cuts=st.lists(st.integers(1, 4), max_size=12),
+)
+def test_the_stream_parser_reads_both_forms_however_split(forms: ModuleType, order: list[int], cuts: list[int]) -> None:
+    stream = b"".join(bytes.fromhex(FRAMES[i][0]) for i in order)
+    parser = forms.StreamParser(forms.Direction.REQUEST)
+    found, position = [], 0
+    for cut in [*cuts, len(stream)]:
+        found += parser.feed(stream[position : position + cut])
+        position += cut
+    expected = [getattr(forms, FRAMES[i][1][0])(**FRAMES[i][1][1]) for i in order]
+    assert found == expected
+
+
+def errors_of(tmp_path: Path, change: Any) -> list[str]:
+    data = copy.deepcopy(SPEC)
+    change(data)
+    with pytest.raises(SpecErrors) as failure:
+        load_protocol(write(tmp_path, data))
+    return [line.split(": ", 2)[-1] for line in str(failure.value).splitlines()]
+
+
+def elements(data: dict[str, Any], layout: str) -> dict[str, Any]:
+    found: dict[str, Any] = data["framing"]["layouts"][layout]["elements"]
+    return found
+
+
+def shared_code(data: dict[str, Any]) -> None:
+    data["commands"]["low_target"] = {"code": 0x04, "request": {"fields": {}}}
+
+
+def bare_code_as_a_header(data: dict[str, Any]) -> None:
+    data["commands"]["go_home"]["code"] = 0xAA
+
+
+def two_bare_layouts(data: dict[str, Any]) -> None:
+    elements(data, "pololu").pop("start")
+
+
+def bare_layout_starting_with_content(data: dict[str, Any]) -> None:
+    compact = elements(data, "compact")
+    compact["content"] = compact.pop("content")
+    data["framing"]["layouts"]["compact"]["elements"] = {"content": compact["content"], "command": compact["command"]}
+
+
+def code_on_a_header(data: dict[str, Any]) -> None:
+    elements(data, "pololu")["start"]["code"] = "code"
+
+
+def no_code_in_it(data: dict[str, Any]) -> None:
+    elements(data, "pololu")["command"]["code"] = "0x7F"
+
+
+def does_not_fit(data: dict[str, Any]) -> None:
+    elements(data, "pololu")["command"]["code"] = "code + 0x80"
+
+
+@pytest.mark.parametrize(
+    ("change", "said"),
+    [
+        (shared_code, "its code in layout pololu, 0x04 (code & 0x7F), is set_target's too: a frame could not tell"),
+        (bare_code_as_a_header, "in layout compact (no header) starts aa, as layout pololu's header aa does"),
+        (two_bare_layouts, "alternative request layouts must start with different headers (one layout without"),
+        (bare_layout_starting_with_content, "alternative request layouts must start with different headers"),
+        (code_on_a_header, "`code` belongs to a command element"),
+        (no_code_in_it, "an expression of `code` (the command's code), e.g. `code & 0x7F`"),
+        (does_not_fit, "its code in layout pololu, 260 (code + 0x80), does not fit the u8 command element (0..255)"),
+    ],
+)
+def test_each_mistake_is_one_line(tmp_path: Path, change: Any, said: str) -> None:
+    found = errors_of(tmp_path, change)
+    assert any(said in line for line in found), found

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from enum import IntEnum, IntFlag
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
@@ -13,7 +12,7 @@ from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
-from serialspec.runtime.message import TYPE_CHECKING, Direction, Message, Record
+from serialspec.runtime.message import TYPE_CHECKING, Direction, IntEnum, IntFlag, Message, Record
 from serialspec.runtime.message import build as _build
 
 if TYPE_CHECKING:  # typing is not imported at run time: a client or `serialspec decode` starts faster

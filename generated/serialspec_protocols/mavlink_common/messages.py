@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from enum import IntEnum, IntFlag
 
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
@@ -14,7 +13,7 @@ from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import number as _number
 from serialspec.runtime.fields import optional_bytes as _optional_bytes
 from serialspec.runtime.fields import text as _text
-from serialspec.runtime.message import TYPE_CHECKING, Direction, Message
+from serialspec.runtime.message import TYPE_CHECKING, Direction, IntEnum, IntFlag, Message
 from serialspec.runtime.message import build as _build
 
 if TYPE_CHECKING:  # typing is not imported at run time: a client or `serialspec decode` starts faster

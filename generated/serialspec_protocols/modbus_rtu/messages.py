@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from enum import IntEnum
 
 from serialspec.runtime.fields import bits as _bits
 from serialspec.runtime.fields import check_given as _check_given
@@ -13,7 +12,7 @@ from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import integers as _integers
-from serialspec.runtime.message import TYPE_CHECKING, Direction, Message
+from serialspec.runtime.message import TYPE_CHECKING, Direction, IntEnum, Message
 from serialspec.runtime.message import build as _build
 
 if TYPE_CHECKING:  # typing is not imported at run time: a client or `serialspec decode` starts faster

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from enum import IntEnum
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_given as _check_given
@@ -16,7 +15,7 @@ from serialspec.runtime.fields import integers as _integers
 from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.fields import text as _text
-from serialspec.runtime.message import TYPE_CHECKING, Direction, Message, Record
+from serialspec.runtime.message import TYPE_CHECKING, Direction, IntEnum, Message, Record
 from serialspec.runtime.message import build as _build
 
 if TYPE_CHECKING:  # typing is not imported at run time: a client or `serialspec decode` starts faster

@@ -4,10 +4,10 @@
 from __future__ import annotations
 
 import struct
+from binascii import crc_hqx as _crc_hqx
 from collections.abc import Callable
 
 from serialspec.checksums.crc import crc_function
-from serialspec.checksums.crc import crc_hqx as _crc_hqx
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type

@@ -8,12 +8,12 @@ runtime wheel ships the package. Importing it finds nothing yet: a generated cod
 
 from __future__ import annotations
 
-import importlib
 import os
 from collections.abc import Mapping
 from functools import cache
 
 from serialspec.checksums.base import _REGISTERED, Algorithm, ChecksumProblem, Report
+from serialspec.runtime import import_module
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
@@ -26,7 +26,7 @@ __all__ = ["Algorithm", "ChecksumProblem", "algorithms", "from_spec", "owned_key
 def algorithms() -> dict[str, type[Algorithm]]:
     """Every algorithm by its `algorithm:` name, in name order."""
     for module in _modules():
-        importlib.import_module(f"{__name__}.{module}")
+        import_module(f"{__name__}.{module}")
     return dict(sorted(_REGISTERED.items()))
 
 

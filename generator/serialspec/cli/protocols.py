@@ -8,12 +8,12 @@ is used with the spec it ships.
 
 from __future__ import annotations
 
-import importlib
 import os
 import sys
 from types import ModuleType
 
 from serialspec.cli.shipped import SHIPPED_NAMESPACE, SHIPPED_SPEC, import_name
+from serialspec.runtime import import_module
 from serialspec.runtime.errors import SerialspecError
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -110,7 +110,7 @@ def _import_if_any(name: str, *, parent_missing: bool = False) -> ModuleType | N
     above it): what importlib.util.find_spec tells before an import, without importing importlib.util (and
     contextlib with it) on the way of `serialspec decode PACKAGE`. An import error inside the module is raised."""
     try:
-        return importlib.import_module(name)
+        return import_module(name)
     except ModuleNotFoundError as exc:
         if exc.name == name or (parent_missing and exc.name and name.startswith(f"{exc.name}.")):
             return None
@@ -133,7 +133,7 @@ def installed_package(name: str) -> tuple[ModuleType, str, bytes]:
         local = not name.isidentifier() or os.path.isfile(os.path.join(name, "__init__.py"))
         # as _import_name chooses: the folder's own package, else the shipped one, else NAME as it is
         package = None if local else _import_if_any(f"{SHIPPED_NAMESPACE}.{name}", parent_missing=True)
-        package = package or importlib.import_module(name)
+        package = package or import_module(name)
     except ImportError:
         package = None
     finally:
@@ -174,7 +174,7 @@ def _in_project(name: str) -> ModuleType | None:
         return None
     sys.path.insert(0, folder)
     try:
-        return importlib.import_module(f"{where.namespace}.{name}" if where.namespace else name)
+        return import_module(f"{where.namespace}.{name}" if where.namespace else name)
     except ImportError:
         return None
     finally:
@@ -201,7 +201,7 @@ def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None
         return None
     if generated_from != spec_text:
         return None
-    return importlib.import_module(name)
+    return import_module(name)
 
 
 def package_in_memory(protocol: Protocol) -> ModuleType:
@@ -214,7 +214,7 @@ def package_in_memory(protocol: Protocol) -> ModuleType:
     with imported(protocol.name, files, protocol.spec_path) as package:
         for module in _MODULES:
             if f"{module}.py" in files:
-                importlib.import_module(f"{protocol.name}.{module}")
+                import_module(f"{protocol.name}.{module}")
     return package
 
 

@@ -4,7 +4,7 @@ checksum registry import: each algorithm's runtime function now lives in its mod
 
 from __future__ import annotations
 
-import importlib
+from serialspec.runtime import import_module
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
@@ -26,5 +26,5 @@ _MOVED = {
 def __getattr__(name: str) -> Any:
     # imported when first asked for: a codec that imports BYTE_VALUES does not pay for every algorithm's module
     if name in _MOVED:
-        return getattr(importlib.import_module(f"serialspec.checksums.{_MOVED[name]}"), name)
+        return getattr(import_module(f"serialspec.checksums.{_MOVED[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

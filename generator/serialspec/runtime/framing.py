@@ -15,10 +15,10 @@ lies inside it or outside it.
 
 from __future__ import annotations
 
-import importlib
 import re
 from collections.abc import Callable, Iterable, Mapping
 
+from serialspec.runtime import import_module
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
@@ -1200,4 +1200,4 @@ def __getattr__(name: str) -> Any:
     found = runtime_classes().get(name)
     if found is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(found[0]), found[1])
+    return getattr(import_module(found[0]), found[1])

@@ -2,14 +2,50 @@
 
 from __future__ import annotations
 
+import enum
 import keyword
 from collections import _tuplegetter  # type: ignore[attr-defined]
 from collections.abc import Callable
-from enum import Enum, IntEnum, StrEnum
+from enum import Enum, StrEnum
 
 # typing.TYPE_CHECKING without importing typing: typing takes about a fifth of a bare Python start, and nothing
 # that `serialspec decode PACKAGE` or a generated package imports needs it at run time (tests/test_cache.py)
 TYPE_CHECKING = False
+
+if TYPE_CHECKING:  # to a type checker, and in what they make, the standard library's classes
+    from enum import IntEnum as IntEnum
+    from enum import IntFlag as IntFlag
+else:
+    try:
+        from enum import _simple_enum  # how the standard library builds its own enums (re, http, ssl) quickly
+    except ImportError:  # a Python without it: generated enums are built the usual way
+        _simple_enum = None
+
+    class _QuickEnum(type):
+        """Builds a generated enum or flag class (`class MavType(IntEnum)`, IntEnum from here) with
+        enum._simple_enum: the very class `class MavType(enum.IntEnum)` makes (a subclass of enum.IntEnum or
+        enum.IntFlag: its members, their repr, str, format and pickling, value lookup, flag boundary and operators;
+        tests/test_quick_enums.py compares them), in about half the time. What it leaves out are the class
+        statement's checks of each member (about 10 µs each), whose names and values the generator checked."""
+
+        def __new__(metacls, cls: str, bases: tuple[type, ...], classdict: dict[str, Any]) -> Any:
+            if not bases:  # IntEnum or IntFlag below: a plain class
+                return super().__new__(metacls, cls, bases, classdict)
+            return _simple_enum(bases[0].standard)(type(cls, (), classdict))
+
+    if _simple_enum is None:
+        IntEnum, IntFlag = enum.IntEnum, enum.IntFlag
+    else:
+
+        class IntEnum(metaclass=_QuickEnum):
+            """The base a generated enum class names: the class made is a subclass of enum.IntEnum."""
+
+            standard = enum.IntEnum
+
+        class IntFlag(metaclass=_QuickEnum):
+            """The base a generated flag class names: the class made is a subclass of enum.IntFlag."""
+
+            standard = enum.IntFlag
 
 
 class Direction(StrEnum):

@@ -10,11 +10,11 @@ through serialspec.runtime.framing), and the runtime wheel ships the package.
 
 from __future__ import annotations
 
-import importlib
 import os
 from collections.abc import Mapping
 from functools import cache
 
+from serialspec.runtime import import_module
 from serialspec.transforms.base import _REGISTERED, DEFAULT, Report, Transform, TransformProblem
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -29,7 +29,7 @@ def transforms() -> dict[str, type[Transform]]:
     """Every transform by its `method:` name, in name order."""
     for module in _modules():
         if module != "base":
-            importlib.import_module(f"{__name__}.{module}")
+            import_module(f"{__name__}.{module}")
     return dict(sorted(_REGISTERED.items()))
 
 

@@ -13,7 +13,6 @@ from collections.abc import Mapping
 from functools import cache
 
 from serialspec.checksums.base import _REGISTERED, Algorithm, ChecksumProblem, Report
-from serialspec.runtime import import_module
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
@@ -26,7 +25,7 @@ __all__ = ["Algorithm", "ChecksumProblem", "algorithms", "from_spec", "owned_key
 def algorithms() -> dict[str, type[Algorithm]]:
     """Every algorithm by its `algorithm:` name, in name order."""
     for module in _modules():
-        import_module(f"{__name__}.{module}")
+        __import__(f"{__name__}.{module}")  # not importlib.import_module: the importlib package costs a start
     return dict(sorted(_REGISTERED.items()))
 
 

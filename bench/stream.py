@@ -20,7 +20,7 @@ from typing import Any
 
 from serialspec.runtime.message import Direction, Message
 
-from bench.handwritten import FsReplyStream, SmsReplyStream, fs_decode_read_angle_reply
+from bench.handwritten import FsFloorStream, FsReplyStream, SmsReplyStream, fs_decode_read_angle_reply
 from bench.timing import Table, compare, times, us, verdict
 
 CHUNK = 4096
@@ -169,6 +169,8 @@ NOISY = {
     "fashionstar_uart": ("READ_ANGLE replies", "FsReplyStream", FsReplyStream),
     "feetech_sms": ("READ replies, 2 data bytes", "SmsReplyStream", SmsReplyStream),
 }
+# what every pure-Python parser of a protocol's noisy stream does at least (bench/handwritten.py), where there is one
+FLOORS: dict[str, Callable[[], Any]] = {"fashionstar_uart": FsFloorStream}
 
 
 def noisy_rows(name: str, make: Callable[[], Message], rng: random.Random) -> list[list[str]]:
@@ -215,6 +217,24 @@ def noisy_rows(name: str, make: Callable[[], Message], rng: random.Random) -> li
                 else "—",
             ]
         )
+        floor = FLOORS.get(name)
+        if floor is not None and target:
+            parse_floor = functools.partial(parse_handwritten, reads, floor)
+            floor_seconds = min(best_seconds(parse_floor, 1)[0] for _ in range(rounds))
+            rows.append(
+                [
+                    name,
+                    "the floor (`FsFloorStream`, not a parser): split at the header, one unpack and one tuple a piece, "
+                    f"no check at all, same stream, {what}",
+                    "8",
+                    stream_text,
+                    "—",
+                    f"{len(stream) / floor_seconds / 1e6:.2f}",
+                    "—",
+                    times(floor_seconds / generated),
+                    "—",
+                ]
+            )
     return rows
 
 

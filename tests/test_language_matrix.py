@@ -194,6 +194,23 @@ CASES: dict[str, Case] = {
         {"v": {"type": "i16", "encoding": "plain"}, "t": {"type": "u16", "encoding": "seven_bit"}, "w": "u8"}
     ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
+    # bit fields (uN/iN of any width) packed MSB first into runs of whole bytes, every integer key on them, a
+    # byte-sized integer inside an open run, a run in a group's items
+    "type: u12, i38 (bit runs)": same(
+        {
+            "msg": {"type": "u12", "const": 1005},
+            "station": {"type": "u12", "range": [0, 4000], "default": 7},
+            "year": "u6",
+            "flag": {"type": "u1", "enum": "mode", "range": [0, 1]},
+            "x": {"type": "i38", "scale": 0.0001, "offset": 1, "unit": "m"},
+            "q": {"type": "u3", "value": "year % 8"},
+            "n": "u4",
+            "b": "i8",
+            "c": "i4",
+            "items": {"type": "group", "count": "n", "fields": {"h": "u5", "l": "i11"}},
+            "tail": "u16",
+        }
+    ),
     "endian: big": same({"v": {"type": "u32", "endian": "big"}, "w": {"type": "f32", "endian": "big"}}),
     "endian: little": same({"v": {"type": "u32", "endian": "little"}}),
     "value (derived)": same({"a": "u8", "b": "u8", "total": {"type": "u16", "value": "a + b * 2"}}),

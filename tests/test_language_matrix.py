@@ -34,6 +34,7 @@ from hypothesis import strategies as st
 from serialspec import cli
 from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
+from serialspec.encodings import bit_run
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
 from serialspec.lang.model import Direction, Message, Protocol, replies_by_request, reply_to
@@ -272,6 +273,35 @@ CASES: dict[str, Case] = {
                     "covers": ["length", "content"],
                 },
                 "trailer": {"role": "trailer", "value": "0D 0A"},
+            }
+        },
+    ),
+    # RTCM 3's frame: a 10-bit length after 6 reserved zero bits (a u16 length with a range) and a 3-byte CRC-24Q
+    "frame: u24 checksum, u16 length with a range": Case(
+        {"v": "u16", "w": "u20", "x": "i4"},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "D3"},
+                "code": {"role": "command", "type": "u8"},
+                "length": {"role": "length", "type": "u16", "endian": "big", "range": [0, 1023]},
+                "content": {"role": "content"},
+                "checksum": {
+                    "role": "checksum",
+                    "type": "u24",
+                    "endian": "big",
+                    "algorithm": "crc",
+                    "covers": ["header", "content"],
+                    "crc": {
+                        "width": 24,
+                        "poly": 0x864CFB,
+                        "init": 0,
+                        "refin": False,
+                        "refout": False,
+                        "xorout": 0,
+                        "check": 0xCDE703,
+                    },
+                },
             }
         },
     ),
@@ -949,7 +979,8 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert {"rest", "int", "str"} - used["size"] == set()
     assert {"rest", "int", "str"} - used["count"] == set()
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
-    assert {"u8", "u16"} - used["element type"] == set()
+    assert {"u8", "u16", "u24"} - used["element type"] == set()
+    assert any(bit_run.width(t) for t in used["type"])  # a bit field (uN/iN of another width)
     assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
 
 

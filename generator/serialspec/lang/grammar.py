@@ -810,7 +810,10 @@ FRAME_ELEMENT = Obj(
                 "optional",
             ),
         ),
-        "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
+        "type": Str(
+            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q).",
+            choices=(*SCALAR_TYPES, "u24"),
+        ),
         "endian": Str(
             "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
             choices=("little", "big"),

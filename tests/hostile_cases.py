@@ -708,7 +708,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "type typo",
         "tiny",
         put("commands/move/request/fields/extra", "uint16"),
-        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, or a field from `fields:`)",
+        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, uN/iN of 1..64 bits, or a field from `fields:`)",
     ),
     (
         "frame element flags typo",

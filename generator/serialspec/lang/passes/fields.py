@@ -182,7 +182,8 @@ class FieldResolver(Pass):
                 return self.expand(self.shared_fields[item], ("fields", item))
             raise self.fail(
                 path,
-                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
+                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, uN/iN of 1..64 bits, or a field "
+                "from `fields:`)",
             )
         if not isinstance(item, dict):
             raise Bad  # neither a type name nor a mapping: the structural check has said so

@@ -276,15 +276,15 @@ CASES: dict[str, Case] = {
             }
         },
     ),
-    # RTCM 3's frame: a 10-bit length after 6 reserved zero bits (a u16 length with a range) and a 3-byte CRC-24Q
-    "frame: u24 checksum, u16 length with a range": Case(
+    # RTCM 3's frame: a 10-bit length after 6 reserved zero bits (a big-endian u16 length) and a 3-byte CRC-24Q
+    "frame: u24 checksum": Case(
         {"v": "u16", "w": "u20", "x": "i4"},
         {"v": "u16"},
         {
             "elements": {
                 "header": {"role": "header", "value": "D3"},
                 "code": {"role": "command", "type": "u8"},
-                "length": {"role": "length", "type": "u16", "endian": "big", "range": [0, 1023]},
+                "length": {"role": "length", "type": "u16", "endian": "big"},
                 "content": {"role": "content"},
                 "checksum": {
                     "role": "checksum",

@@ -1,6 +1,6 @@
 """RTCM 3 (tests/specs/rtcm3.yaml), written as a new user would from RTCM's own tables: a payload of integer data
 fields of any width packed highest bit first (bit fields `u12`, `i38`: serialspec/encodings/bit_run.py), in a frame
-of preamble D3, a 10-bit length after six reserved zero bits (a u16 length ranged 0..1023) and a CRC-24Q (a `u24`
+of preamble D3, a 10-bit length after six reserved zero bits (read as one big-endian u16) and a CRC-24Q (a `u24`
 checksum). Checked against pyrtcm: its frames decode to its values and encode back byte for byte, it parses the
 frames we make, and hypothesis round trips random bit runs through the codec and construct's structs."""
 
@@ -220,7 +220,8 @@ def test_a_run_short_of_a_byte_is_one_spec_error() -> None:
     strict=True,
     reason="the gap: a message picked by its 12-bit message number (the payload's first field, a bit field) where "
     "sizes overlap (1033's counted strings beside 1005 and 1006): frames without a command element are told apart by "
-    "size only, and a sub-command selector is whole bytes",
+    "size only, and a sub-command selector is whole bytes. (Also left: the length's 6 reserved bits are read as part "
+    "of a u16 length, not checked to be 0: a length element's `range` is not enforced by the frame engines.)",
 )
 def test_messages_picked_by_their_message_number() -> None:
     text = (

@@ -204,4 +204,5 @@ def markdown_where(offset: int, bits: int, shift: int, size: int) -> str:
     at, first, last = span(bits, shift, size)
     where = str(offset + first) if first == last else f"{offset + first}..{offset + last}"
     which = f"bit {at}" if bits == 1 else f"bits {at}..{at + bits - 1}"
-    return f"{where} ({which} of {offset}..{offset + size - 1})"
+    run = str(offset) if size == 1 else f"{offset}..{offset + size - 1}"
+    return f"{where} ({which} of {run})"

@@ -266,6 +266,48 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("serial/parity", "mark"),
         "serial.parity: unknown value 'mark' (expected one of none, even, odd)",
     ),
+    # bit fields (uN/iN of any width, serialspec/encodings/bit_run.py): runs end on a byte boundary
+    (
+        "bit run short of a byte",
+        "tiny",
+        put("commands/move/request/fields/angle", "u12"),
+        "commands.move.request.fields.angle: bit run angle: 36 bits at the end of the content, not a whole number "
+        "of bytes (add fields or reserved bits to fill 40)",
+    ),
+    (
+        "bit run cut by text",
+        "tiny",
+        both(
+            put("commands/move/request/fields/a", "u4"),
+            put("commands/move/request/fields/s", {"type": "string", "size": 2}),
+            put("commands/move/request/fields/b", "u4"),
+        ),
+        "commands.move.request.fields.a: bit run a: 4 bits before s, not a whole number of bytes (add fields or "
+        "reserved bits to fill 8)",
+    ),
+    (
+        "bit field of 65 bits",
+        "tiny",
+        put("commands/move/request/fields/angle", {"type": "i65"}),
+        "commands.move.request.fields.angle.type: unknown type 'i65' (expected one of u8, i8, u16, i16, u24, i24, "
+        "u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, or uN/iN of "
+        "1..64 bits)",
+    ),
+    (
+        "bit field with endian",
+        "tiny",
+        both(
+            put("commands/move/request/fields/angle", {"type": "i12", "endian": "big"}),
+            put("commands/move/request/fields/pad", "u4"),
+        ),
+        "commands.move.request.fields.angle.endian: `endian` does not go with a bit field (i12: packed MSB first)",
+    ),
+    (
+        "u24 length",
+        "tiny",
+        put("framing/elements/length/type", "u24"),
+        "framing.elements.length.type: u24 is a checksum's type, not a length's",
+    ),
     (
         "scale 0",
         "tiny",
@@ -666,7 +708,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "type typo",
         "tiny",
         put("commands/move/request/fields/extra", "uint16"),
-        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, or a field from `fields:`)",
+        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, uN/iN of 1..64 bits, or a field from `fields:`)",
     ),
     (
         "frame element flags typo",

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "1e276b5f5c482e15446130f97279ad76b2e3986e82034c29e7a469a68b3ebb38"
+#define CRSF_SPEC_SHA256 "62a620453853469e2bc71dec701bf228eb0fee066f583cc80d0e6e4f204be79a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "6460d66e0546db67eaa4cd08ea0986ac9cacae9b574ae4a4438eff803d1fdca9"
+#define DYNAMIXEL_P2_SPEC_SHA256 "df95a0da804889d223afedd3d3f0313475a8a512ef46486160a0b5373235d959"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "42328266b8308ebf35f5416330b020b228c1282a4cb713e000b66ee72bdfbd06"
+#define FEETECH_SMS_SPEC_SHA256 "835fddc02bfd173532c1cb2099f33751026055df6a3a04ee65a4451f50d9b469"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

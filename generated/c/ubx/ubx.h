@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "43a2c35fb70e1d7dabc66565602aef9012b5869e2733fb48a5fd5a407b42444f"
+#define UBX_SPEC_SHA256 "ba81c823e107ad9dfc38158bebf67facc0f0ce19242597ec86f02b390cabe596"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

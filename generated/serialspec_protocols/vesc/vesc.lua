@@ -986,7 +986,11 @@ end
 local declare
 local function declare_field(f, abbr)
   local kind = f.kind
-  if kind == "scalar" then
+  if kind == "bit_member" then -- a member of a bit run: a 32- or 64-bit field
+    local make = f.width > 32 and (f.signed and ProtoField.int64 or ProtoField.uint64)
+      or (f.signed and ProtoField.int32 or ProtoField.uint32)
+    f.pf = new(abbr, function() return make(abbr, f.name, base.DEC, f.enum, nil, f.description) end)
+  elseif kind == "scalar" then
     local spec_type = f.sign_magnitude and "i" .. f.type:sub(2) or f.type
     f.pf = new(abbr, function() return scalar_field(abbr, f.name, spec_type, f.enum, nil, f.description) end)
     declare_bits(f, abbr, SIZES[f.type])
@@ -1312,6 +1316,17 @@ end
 
 local decode_fields
 
+local function annotate(f, item, value, scope)
+  if f.unit and f.unit ~= "" and not (f.enum or f.flags or f.bits) then
+    if f.scale or f.offset then
+      item:append_text(" (" .. with_unit(engineering(value * (f.scale or 1) + (f.offset or 0)), f.unit) .. ")")
+    else
+      item:append_text(" " .. f.unit)
+    end
+  end
+  scope[f.name] = value
+end
+
 local function add_scalar(f, tree, range, scope)
   local value = number(range, f.type, f.big)
   local item
@@ -1328,15 +1343,9 @@ local function add_scalar(f, tree, range, scope)
   end
   for _, b in ipairs(f.bits or {}) do add(item, b.pf, range, f.big) end
   for _, flag in ipairs(f.flags or {}) do add(item, flag.pf, range, f.big) end
-  if f.unit and f.unit ~= "" and not (f.enum or f.flags or f.bits) then
-    if f.scale or f.offset then
-      item:append_text(" (" .. with_unit(engineering(value * (f.scale or 1) + (f.offset or 0)), f.unit) .. ")")
-    else
-      item:append_text(" " .. f.unit)
-    end
-  end
-  scope[f.name] = value
+  annotate(f, item, value, scope)
 end
+
 
 local function size_of(f, scope, rest)
   if type(f.size) == "number" then return f.size end
@@ -1376,6 +1385,13 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
       list:add(f.item, tvb(pos + first, last - first + 1), f.signed and Int64(value) or UInt64(value))
     end
     return pos + size
+  elseif kind == "bit_member" then -- a member of a bit run: its bits of the run's bytes, its bytes shown
+    need(tvb, pos, f.size, stop, f.name)
+    local first, last = math.floor(f.at / 8), math.floor((f.at + f.width - 1) / 8)
+    local value = bit_member(tvb, pos, f.at, f.width, f.signed)
+    local shown = f.width <= 32 and value or (f.signed and Int64(value) or UInt64(value))
+    annotate(f, tree:add(f.pf, tvb(pos + first, last - first + 1), shown), value, scope)
+    return f.last and pos + f.size or pos
   elseif kind == "scalar" then
     add_scalar(f, tree, need(tvb, pos, SIZES[f.type], stop, f.name), scope)
     return pos + SIZES[f.type]

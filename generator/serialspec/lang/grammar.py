@@ -14,7 +14,7 @@ from typing import Any, assert_never
 
 from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
-from serialspec.encodings import seven_bit
+from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
@@ -359,9 +359,9 @@ def bit_fields(description: str) -> MapOf:
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str(
         "Wire type: u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring "
-        "(NUL-terminated text), array, group, table_value, table_block. In text frames: decimal, integer, angle "
-        "(ddmm.mmmm degrees and minutes), char, text, time (hhmmss.ss), date (ddmmyy), repeat (a group of `fields` "
-        "repeated `count` times, or up to `max_count` times at the end); an empty field is None."
+        f"(NUL-terminated text), array, group, table_value, table_block; {bit_run.DOC}. In text frames: decimal, "
+        "integer, angle (ddmm.mmmm degrees and minutes), char, text, time (hhmmss.ss), date (ddmmyy), repeat (a group "
+        "of `fields` repeated `count` times, or up to `max_count` times at the end); an empty field is None."
     ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "label": Str(
@@ -810,7 +810,10 @@ FRAME_ELEMENT = Obj(
                 "optional",
             ),
         ),
-        "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
+        "type": Str(
+            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q).",
+            choices=(*SCALAR_TYPES, "u24"),
+        ),
         "endian": Str(
             "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
             choices=("little", "big"),

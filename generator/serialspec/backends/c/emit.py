@@ -21,7 +21,7 @@ from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.frames import refuse_by_command, refuse_code_forms
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
-from serialspec.encodings import seven_bit
+from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -544,12 +544,34 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
         match f:
             case Scalar():
                 size = f.type.size
-                out.append(f"{pad}if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
+                place = f.bit_place
+                if place is None or place.first:
+                    run = size if place is None else place.size
+                    out.append(f"{pad}if (n - o < {run}u) {{ return {ctx.P}_E_LENGTH; }}")
                 # a hidden value keeps its wire bits, a signed one its value (as Python compares it); a constant
                 # only its bits: no helper is written that nothing calls
                 needs_value = f.const is None and (not f.hidden or f.type.signed) and not f.sign_magnitude
                 needs_value = needs_value and not f.seven_bit
-                value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value else ""
+                value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value and place is None else ""
+                if place is not None:  # a member of a bit run: its bits of the run (encodings/bit_run.py)
+                    w = bit_run.c_width(place.bits)
+                    ctx.helpers |= {f"bits{w}", f"sx{w}"} if f.type.signed else {f"bits{w}"}
+                    raw = bit_run.c_decode(ctx.p, "c + o", place.bits, place.shift, place.size, False)
+                    signed = bit_run.c_decode(ctx.p, "c + o", place.bits, place.shift, place.size, f.type.signed)
+                    value = f"({ctype(f.type)}){signed}"
+                    if f.const is not None:
+                        out.append(f"{pad}if ({raw} != {f.const & place.mask}u) {{ return {ctx.P}_E_CONTENT; }}")
+                    elif f.hidden:
+                        local = f"d{depth}_{name}"
+                        out.append(f"{pad}{local} = {signed if f.type.signed else raw};")
+                        scope.names[f.name] = local
+                    else:
+                        out.append(f"{pad}{tgt} = {value};")
+                        unsigned = not (wide(f.type) or f.type.signed)
+                        scope.names[f.name] = f"(uint32_t){tgt}" if unsigned else tgt
+                    if place.last:
+                        out.append(f"{pad}o += {place.size}u;")
+                    continue
                 if f.seven_bit:  # 7 bits a byte, bit 7 of each clear
                     raw = get_raw(ctx, f.type, f.endian, "c + o")
                     marks = seven_bit.marks(size)
@@ -1147,6 +1169,17 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                         value = f"({tgt} < 0 ? ((uint32_t)(-(int32_t){tgt}) | 0x{top:x}UL) : (uint32_t){tgt})"
                     if f.seven_bit:
                         value = seven_bit.c_encode(tgt, size)
+                place = f.bit_place
+                if place is not None:  # a member of a bit run: its bits into the run (encodings/bit_run.py)
+                    if place.first:
+                        out.append(f"{pad}if (cap - o < {place.size}u) {{ return {ctx.P}_E_BUFFER; }}")
+                        out.append(f"{pad}memset(c + o, 0, {place.size}u);")
+                    ctx.helpers.add(f"setbits{bit_run.c_width(place.bits)}")
+                    write = bit_run.c_encode(ctx.p, "c + o", place.bits, place.shift, place.size, value)
+                    out.append(f"{pad}{write} /* {f.name} */")
+                    if place.last:
+                        out.append(f"{pad}o += {place.size}u;")
+                    continue
                 out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
                 out.append(f"{pad}{put_call(ctx, f.type, f.endian, 'c + o', value)} /* {f.name} */")
                 out.append(f"{pad}o += {size}u;")

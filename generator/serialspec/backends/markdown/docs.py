@@ -18,6 +18,7 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
 from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
 from serialspec.collection import without_cycle_collection
+from serialspec.encodings import bit_run
 from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
@@ -149,6 +150,9 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
         if offset is not None and size is None:
             where = f"{offset}.."
+        if isinstance(f, Scalar) and (place := f.bit_place) is not None:  # its bytes and bits of its run
+            start = None if offset is None else offset if place.first else offset - place.size  # counted at the first
+            where = "" if start is None else bit_run.markdown_where(start, place.bits, place.shift, place.size)
         rows.append(Row(where, prefix + f.name, type_name(f), kind(f).unit(f), range_text(f), meaning(f)))
         match f:  # the rows of what it holds
             case Group():
@@ -686,6 +690,18 @@ def content_rows(
                 if f.derived[0] == "count" or not target
                 else "derived"
             )
+        if isinstance(f, Scalar) and (place := f.bit_place) is not None:  # the bytes it touches
+            _, first, last = bit_run.span(place.bits, place.shift, place.size)
+            shown = "derived" if f.derived else value
+            rows.append(
+                {
+                    "bytes": frame[offset + first : offset + last + 1].hex(" ").upper(),
+                    "field": f.name,
+                    "value": cell(_show(shown)),
+                }
+            )
+            offset += place.size if place.last else 0
+            continue
         if size is None:
             if isinstance(f, Group):
                 items = values.get(f.name)  # recorded values; a malformed record is a spec error of its own

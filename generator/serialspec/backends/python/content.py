@@ -57,7 +57,7 @@ from serialspec.backends.python.optimize import (
     read_fields_once,
 )
 from serialspec.backends.python.render import one_line
-from serialspec.encodings import seven_bit
+from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Array,
@@ -539,9 +539,13 @@ class PackageCode:
         simple = all(isinstance(f, Scalar | Bytes) for f in run)
         values: list[str] = []
         if simple:
-            names = [self.local(f) for f in run]
+            read = [f for f in run if not isinstance(f, Scalar) or f.bit_place is None or f.bit_place.first]
+            names = [self.local(f) + ("_run" if isinstance(f, Scalar) and f.bit_place else "") for f in read]
             body.append(Unpack(tuple(names), const_name, byte=fmt in ("<B", ">B")))
-            for f, name in zip(run, names, strict=True):
+            for f in run:
+                name = self.local(f)
+                if isinstance(f, Scalar) and f.bit_place is not None:
+                    self.bit_member(f, f"{self.local_named(f.bit_place.run)}_run", body)
                 expr = self.after_unpack(f, name, body, where)
                 if expr is not None:
                     values.append(expr)
@@ -562,8 +566,14 @@ class PackageCode:
                     values.append(self.local(f))
                 else:
                     name = self.local(f)
-                    body.append(Code(f"{name} = t[{position}]"))
-                    position += 1
+                    if isinstance(f, Scalar) and f.bit_place is not None:
+                        if f.bit_place.first:
+                            body.append(Code(f"{name}_run = t[{position}]"))
+                            position += 1
+                        self.bit_member(f, f"{self.local_named(f.bit_place.run)}_run", body)
+                    else:
+                        body.append(Code(f"{name} = t[{position}]"))
+                        position += 1
                     expr = self.after_unpack(f, name, body, where)
                     if expr is not None:
                         values.append(expr)
@@ -573,6 +583,16 @@ class PackageCode:
     @staticmethod
     def local(f: SpecField) -> str:
         return f"v_{f.name}"
+
+    def bit_member(self, f: Scalar, run: str, body: Block) -> None:
+        """A member of a bit run from the run's bytes (`run`, read by the struct): the run is one integer, made by
+        its first member, and each member its bits (encodings/bit_run.py)."""
+        place = f.bit_place
+        assert place is not None
+        if place.first:
+            body.append(Code(f"{run} = int.from_bytes({run}, 'big')"))
+        value = bit_run.python_decode(run, place.bits, place.shift, place.size, f.type.signed)
+        body.append(Code(f"{self.local(f)} = {value}"))
 
     def after_unpack(self, f: SpecField, name: str, body: Block, where: str) -> str | None:
         """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
@@ -683,9 +703,16 @@ class PackageCode:
                 body.append(Code(f"n = {count} * {f.item_size}"))
                 reason = f"content too short for its count ({{{count}}} {f.name})"
                 body.append(Needs("n", f"DecodeError({where} + f': {reason}')"))
-            names = [self.local(i) for i in item_fields]
             item_body: Block = []
-            item_values = [self.after_unpack(i, n, item_body, where) for i, n in zip(item_fields, names, strict=True)]
+            names = []
+            for i in item_fields:  # a bit run's bytes read at its first field, each field's bits from them
+                if isinstance(i, Scalar) and i.bit_place is not None:
+                    run = f"{self.local_named(i.bit_place.run)}_run"
+                    names += [run] if i.bit_place.first else []
+                    self.bit_member(i, run, item_body)
+                else:
+                    names.append(self.local(i))
+            item_values = [self.after_unpack(i, self.local(i), item_body, where) for i in item_fields]
             values = [v for v in item_values if v is not None]
             items = f"{item_struct}.iter_unpack(buf[o : o + n])"
             if not item_body and values == names:  # the unpacked tuples are the items' values
@@ -956,6 +983,15 @@ class PackageCode:
         args: list[str] = []
         for f in run:
             match f:
+                case Scalar() if f.bit_place is not None:
+                    place = f.bit_place
+                    if place.first:  # the run's bytes from every member's value (encodings/bit_run.py)
+                        parts = [
+                            (self.wire_value(m, obj, siblings, body, where), at.bits, at.shift, m.type.signed)
+                            for m in run
+                            if isinstance(m, Scalar) and (at := m.bit_place) is not None and at.run == f.name
+                        ]
+                        args.append(bit_run.python_encode(parts, place.size))
                 case Scalar() if f.odd_width:
                     order = "big" if f.endian == ">" else "little"
                     wire = self.wire_value(f, obj, siblings, body, where)

@@ -126,6 +126,13 @@ def bits_expr(f: Scalar) -> str:
     return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
 
 
+def bit_member(f: Scalar) -> str:
+    """The construct of a member of a bit run (encodings/bit_run.py's `member`)."""
+    place = f.bit_place
+    assert place is not None
+    return f"BitRunMember({place.bits}, {place.shift}, {place.size}, {f.type.signed}, {place.earlier!r})"
+
+
 def declared_range(f: Scalar) -> str:
     """Rebuilt's range arguments: a computed value's declared range where it is narrower than its type's (decode
     refuses a value outside it, as encode does), else none."""
@@ -138,7 +145,7 @@ class ScalarKind(Kind[Scalar]):
     model = Scalar
 
     def construct(self, f: Scalar, parent: str) -> str:
-        base = primitive(f.type, f.endian)
+        base = primitive(f.type, f.endian) if f.bit_place is None else bit_member(f)
         if f.const is not None:
             return f"Const({f.const}, {base})"
         if f.value is not None:
@@ -164,6 +171,8 @@ class ScalarKind(Kind[Scalar]):
         return True
 
     def struct_chars(self, f: Scalar) -> str:
+        if f.bit_place is not None:  # the run's bytes, read at its first field (encodings/bit_run.py)
+            return f"{f.bit_place.size}s" if f.bit_place.first else ""
         return f.type.struct_char
 
     def annotation(self, f: Scalar) -> str:

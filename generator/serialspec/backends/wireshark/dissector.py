@@ -14,7 +14,7 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
-from serialspec.encodings import seven_bit
+from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -77,6 +77,9 @@ def emit_dissector(protocol: Protocol) -> str:
         # the `encoding: seven_bit` function, where a field uses it
         seven_bit_lua=seven_bit.LUA
         if any(isinstance(f, Scalar) and f.seven_bit for m in protocol.messages() for f in _all_fields(m.fields))
+        else "",
+        bit_run_lua=bit_run.LUA
+        if any(isinstance(f, Scalar) and f.bit_place for m in protocol.messages() for f in _all_fields(m.fields))
         else "",
     )
 
@@ -267,6 +270,8 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
             common["sign_magnitude"] = item.sign_magnitude
             if item.seven_bit:  # (absent: nil, false to the engine)
                 common["seven_bit"] = True
+            if (place := item.bit_place) is not None:  # a member of a bit run (encodings/bit_run.py)
+                common.update(bit_run.lua_field(place.bits, place.shift, place.size, item.type.signed))
         case Array():
             common.update(kind="list", type=item.item.name, big=item.endian == ">", count=item.count, unit=item.unit)
         case List():

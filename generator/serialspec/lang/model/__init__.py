@@ -91,6 +91,9 @@ from serialspec.lang.model.fields import (
     BitField as BitField,
 )
 from serialspec.lang.model.fields import (
+    BitPlace as BitPlace,
+)
+from serialspec.lang.model.fields import (
     Bytes as Bytes,
 )
 from serialspec.lang.model.fields import (

@@ -92,6 +92,30 @@ class BitField:
 
 
 @frozen
+class BitPlace:
+    """A field's place in a bit run (encodings/bit_run.py: `type: u12` and the fields packed with it): the run is
+    read as one big-endian integer of `size` bytes, the field `shift` bits above its lowest bit."""
+
+    run: str  # the name of the run's first field
+    bits: int
+    shift: int
+    size: int
+    earlier: tuple[tuple[str, int, int], ...] = ()  # the last field's: (name, bits, shift) of the fields before it
+
+    @property
+    def first(self) -> bool:
+        return self.shift + self.bits == self.size * 8
+
+    @property
+    def last(self) -> bool:
+        return self.shift == 0
+
+    @property
+    def mask(self) -> int:
+        return (1 << self.bits) - 1
+
+
+@frozen
 class Common:
     """What every field kind carries."""
 
@@ -126,11 +150,12 @@ class Scalar(Common):
     offset: float | None = None  # engineering value = wire value × scale + offset
     value_at: tuple[int, int] = (1, 1)  # line and column of `value:` in the spec, for a target's refusal of it
     seven_bit: bool = False  # `encoding: seven_bit`: 7 bits a byte (serialspec/encodings/seven_bit.py)
+    bit_place: BitPlace | None = None  # a member of a bit run (serialspec/encodings/bit_run.py)
 
     @property
     def odd_width(self) -> bool:
         """A 3-byte integer: read as 3 bytes and converted, since struct has no format for it."""
-        return self.type.size == 3
+        return self.type.size == 3 and self.bit_place is None
 
     @property
     def hidden(self) -> bool:

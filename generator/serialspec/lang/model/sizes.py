@@ -8,6 +8,8 @@ from serialspec.lang.model.fields import Array, Bytes, Field, Group, List, Packe
 
 
 def fixed_size(field: Field) -> int | None:
+    if isinstance(field, Scalar) and field.bit_place is not None:  # the run's bytes, counted at its first field
+        return field.bit_place.size if field.bit_place.first else 0
     if isinstance(field, Scalar):
         return field.type.size
     if isinstance(field, Array):

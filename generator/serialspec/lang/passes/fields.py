@@ -6,13 +6,14 @@ import re
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec.encodings import seven_bit
+from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import expression, grammar
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     SCALARS,
     Array,
     BitField,
+    BitPlace,
     Bytes,
     Field,
     Group,
@@ -65,7 +66,34 @@ class FieldResolver(Pass):
             if field is not None:
                 resolved.append(field)
         self.check_values(resolved, path)
-        return tuple(resolved)
+        return tuple(self.bit_runs(resolved, path))
+
+    def bit_runs(self, fields: list[Field], path: Path) -> list[Field]:
+        """Each field of a bit run (encodings/bit_run.py) with its place; a run that does not end on a byte boundary
+        is an error at its first field."""
+
+        def bits(f: Field) -> int | None:
+            plain = isinstance(f, Scalar) and not (f.type.is_float or f.bits or f.sign_magnitude or f.seven_bit)
+            if not isinstance(f, Scalar) or not plain:
+                return None
+            return bit_run.width(f.type.name) or f.type.size * 8
+
+        listed = [(f.name, bits(f), isinstance(f, Scalar) and bit_run.width(f.type.name) is not None) for f in fields]
+        runs, problem = bit_run.runs(listed)
+        if problem is not None:
+            self.error((*path, problem[0]), problem[1])
+        by_name = {f.name: f for f in fields}
+        for run in runs:
+            size, shift = sum(b for _, b in run) // 8, sum(b for _, b in run)
+            earlier: list[tuple[str, int, int]] = []
+            for name, width in run:
+                shift -= width
+                field = by_name[name]
+                assert isinstance(field, Scalar)
+                place = BitPlace(run[0][0], width, shift, size, tuple(earlier) if shift == 0 else ())
+                by_name[name] = replace(field, bit_place=place)
+                earlier.append((name, width, shift))
+        return [by_name[f.name] for f in fields]
 
     def check_values(self, fields: list[Field], path: Path) -> None:
         """Every `value:` expression names fields of the same content, and no value depends on itself."""
@@ -148,13 +176,14 @@ class FieldResolver(Pass):
     def expand(self, item: Any, path: Path) -> dict[str, Any]:
         """A field's mapping, with the short forms and `use:` references expanded."""
         if isinstance(item, str):
-            if item in FIELD_KINDS:
+            if item in FIELD_KINDS or bit_run.width(item):
                 return {"type": item}
             if item in self.shared_fields:
                 return self.expand(self.shared_fields[item], ("fields", item))
             raise self.fail(
                 path,
-                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
+                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, uN/iN of 1..64 bits, or a field "
+                "from `fields:`)",
             )
         if not isinstance(item, dict):
             raise Bad  # neither a type name nor a mapping: the structural check has said so
@@ -184,7 +213,7 @@ class FieldResolver(Pass):
             inferred=str(spec.get("inferred", "")),
         )
         endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
-        if kind in SCALARS:
+        if kind in SCALARS or bit_run.width(kind):
             return self.scalar(common, spec, path, endian)
         if kind == "bytes":
             size = spec.get("size")
@@ -286,7 +315,8 @@ class FieldResolver(Pass):
             return TableBlock(
                 **common, table=table, class_name=class_name, entries=entries, endian=endian, struct_name=struct_name
             )
-        raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
+        kinds = ", ".join(FIELD_KINDS)
+        raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {kinds}, or uN/iN of 1..64 bits)")
 
     def pad(self, pad: Any, size: Any, path: Path) -> int | None:
         """The pad byte of a fixed-size string, from its hex ('00')."""
@@ -386,7 +416,9 @@ class FieldResolver(Pass):
 
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
-        scalar = self.stored(SCALARS[spec["type"]], sign_magnitude, (*path, "encoding"))
+        scalar = self.stored(field_type(spec["type"]), sign_magnitude, (*path, "encoding"))
+        if bit_run.width(scalar.name) and (odd := [k for k in ("bits", "flags", "encoding", "endian") if k in spec]):
+            self.error((*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)")
         seven_bits = spec.get("encoding") == seven_bit.NAME
         if seven_bits and (why := seven_bit.problem(scalar.name, scalar.signed, scalar.is_float)):
             self.error((*path, "encoding"), why)
@@ -486,6 +518,15 @@ class FieldResolver(Pass):
             self.derive(size, ("size", name), parent, path)
         else:
             self.derive(size, ("size", name), siblings, path)
+
+
+def field_type(name: str) -> ScalarType:
+    """A field's integer or float type by name: one of SCALARS, or a bit-field type (u12, i38)."""
+    bits = bit_run.width(name)
+    if bits is None:
+        return SCALARS[name]
+    low, high = bit_run.limits(bits, name.startswith("i"))
+    return ScalarType(name, bit_run.size_of(bits), "", name.startswith("i"), False, low, high)
 
 
 LISTS = (Array, Packed, List, Bytes, Text, Group)

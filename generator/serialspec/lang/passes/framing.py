@@ -180,7 +180,12 @@ class FramingPass(FieldResolver):
             size = item["size"]
             if not isinstance(size, int) or not 1 <= size <= 255:
                 raise self.fail((*path, "size"), "an optional element's size is 1..255 bytes")
+        elif role == "checksum" and item.get("type") == "u24":  # a 3-byte checksum (RTCM 3's CRC-24Q)
+            scalar = self.scalar_type("u24", (*path, "type"), allow_float=False, for_field=True)
+            size = scalar.size
         elif role not in CONSTANT_ROLES and role != "content":
+            if item.get("type") == "u24":
+                raise self.fail((*path, "type"), f"u24 is a checksum's type, not a {role}'s")
             scalar = self.scalar_type(item.get("type", "u8"), (*path, "type"), allow_float=False)
             size = scalar.size
         elif "type" in item:

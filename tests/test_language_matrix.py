@@ -464,6 +464,8 @@ def spec_text(name: str, case: Case) -> str:
     elements = next(iter(framing["layouts"].values()))["elements"] if "layouts" in framing else framing["elements"]
     address = next((n for n, e in elements.items() if e["role"] == "address"), None)
     answered = address is not None and "response" in elements[address].get("directions", ["response"])
+    layouts = [layout["elements"] for layout in framing["layouts"].values()] if "layouts" in framing else [elements]
+    coded = any(e["role"] == "command" for layout in layouts for e in layout.values())
     matching = [address, "command"] if answered else ["command"]
     spec: dict[str, Any] = {
         "protocol": "matrix_case",
@@ -472,7 +474,7 @@ def spec_text(name: str, case: Case) -> str:
         "byte_order": "little",
         "serial": {"baudrate": 115200},
         "framing": framing,
-        "matching": {"by": matching},
+        **({"matching": {"by": matching}} if coded else {}),
         **copy.deepcopy(SHARED),
         "commands": {
             "probe": {
@@ -485,6 +487,8 @@ def spec_text(name: str, case: Case) -> str:
         },
         "device": {"memory": "regs", **({"address": address} if address else {}), **copy.deepcopy(case.device or {})},
     }
+    if not coded:  # the one command of frames without a command element has no code
+        del spec["commands"]["probe"]["code"]
     return yaml.safe_dump(spec, sort_keys=False, allow_unicode=True)
 
 
@@ -583,6 +587,19 @@ CASES["frame: plain values, a sequence"] = Case(
             "length": {"role": "length", "type": "u8"},
             "content": {"role": "content"},
             "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+)
+# No command element: one command, its frame a header, a length byte, the content and a sum (generate crashed here)
+CASES["frame: no command element, a length byte"] = Case(
+    {"v": "u16", "w": "u8"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["length", "content"]},
         }
     },
 )

@@ -106,8 +106,11 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         directions.append(
             {
                 "slice_key": slice_key,
-                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
-                "slice_rests": [slice_rest(layout, r) for r in rests],
+                # (only where the command code and length byte lie side by side: key_slice)
+                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed]
+                if slice_key
+                else [],
+                "slice_rests": [slice_rest(layout, r) for r in rests] if slice_key else [],
                 "accepted": [inside for _, inside, _ in range_checks],
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],

@@ -28,6 +28,7 @@ from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, wi
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
+from serialspec.backends.common.frames import layout_codes, layout_index
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
 from serialspec.transforms.replace import Replace
 
@@ -417,6 +418,58 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     return "\n".join(lines), name
 
 
+def chosen_functions(ctx: Ctx) -> str:
+    """Layouts chosen by command (`layout:`): which codes each layout sends ({p}__sends), and whether a frame carries,
+    at its layout's fixed command offset, a code that layout sends ({p}__sends_at: runtime/framing.py _code_at, for
+    FrameCodec.unwrap's choice of whose refusal counts). "" for other protocols."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    if not protocol.framing.by_command:
+        return ""
+    sends: list[str] = []
+    at: list[str] = []
+    for d in directions(protocol):
+        for k, layout in enumerate(protocol.framing.alternatives[d]):
+            codes = layout_codes(protocol, layout)
+            if codes is None:
+                continue
+            test = " || ".join(f"code == {c}L" for c in codes) or "0"
+            sends.append(f"    if (dir == {P}_{d.name} && k == {k}u) {{\n        return {test};\n    }}")
+            index = next(i for i, e in enumerate(layout.elements) if e.role == "command")
+            content = next((i for i, e in enumerate(layout.elements) if e.role == "content"), len(layout.elements))
+            if index < content:
+                e = layout.elements[index]
+                offset = sum(x.size or 0 for x in layout.elements[:index])
+                value = _wire_value((False, offset), e.size or 0, e.endian == ">")
+                at.append(
+                    f"    if (dir == {P}_{d.name} && k == {k}u) {{\n"
+                    f"        return n >= {offset + (e.size or 0)}u && {p}__sends(dir, k, (long)({value}));\n    }}"
+                )
+    return f"""
+#if {P}_ENABLE_DECODE
+/* Layouts chosen by command (`layout:`): 1 when the direction's layout k sends code `code` (a layout without a
+ * command element sends every message it is chosen for). */
+static int {p}__sends({p}_direction_t dir, uint8_t k, long code)
+{{
+    (void)code;
+{chr(10).join(sends)}
+    return 1;
+}}
+
+/* 1 when frame f[0..n) reaches layout k's command element (at its fixed offset) and carries a code the layout sends:
+ * that layout's refusal is the frame's (runtime/framing.py FrameCodec.unwrap). */
+static int {p}__sends_at({p}_direction_t dir, uint8_t k, const uint8_t *f, size_t n)
+{{
+    (void)dir;
+    (void)k;
+    (void)f;
+    (void)n;
+{chr(10).join(at)}
+    return 0;
+}}
+#endif
+"""
+
+
 def every_layout(protocol: Protocol) -> list[FrameLayout]:
     return [layout for layouts in protocol.framing.alternatives.values() for layout in layouts]
 
@@ -528,6 +581,8 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             lines.append(
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
             )
+            if layout_codes(ctx.protocol, layout) is not None:  # layouts chosen by command: a code sent in it
+                lines.append(f"    if (!{p}__sends({P}_{direction.name}, {k}u, code)) {{ return {P}__NONE; }}")
         elif e.role in VALUE_ROLES:
             test = _range_test(e, "v", sizes[i], _need(ctx, direction, k, e))
             if test is not None:
@@ -551,6 +606,8 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             f"      if (content < (long)low || (bounded && content > (long)high)) {{ return {P}__NONE; }}",
             f"      return {sum(sizes) - counted}L + counted; }}",
         ]
+    elif command > first and elements[-1].role not in ("header", "trailer", "constant"):
+        lines += trailing_probe(ctx, direction, layout, sizes, command)
     else:
         lines += terminated_probe(ctx, direction, k, layout, sum(sizes))
         lines += [
@@ -561,6 +618,31 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
         ]
     lines += ["}", ""]
     return "\n".join(lines)
+
+
+def trailing_probe(ctx: Ctx, direction: Direction, layout: FrameLayout, sizes: list[int], command: int) -> list[str]:
+    """The probe's lines for a frame whose command element follows a content of one size per code, with no length
+    or trailer to size it (TFmini's configuration frames): the smallest frame size whose code is in the command
+    element there (runtime/framing.py _by_trailing_code)."""
+    P = ctx.P
+    codes = layout_codes(ctx.protocol, layout)
+    e = layout.elements[command]
+    first = sum(sizes[command:])
+    found = sorted(
+        (sum(sizes) + users[0].min_size, code)
+        for code, users in messages_by_code(ctx.protocol, direction).items()
+        if code is not None
+        and code >= 0
+        and (codes is None or code in codes)
+        and len({(u.min_size, u.max_size) for u in users}) == 1
+        and users[0].min_size == users[0].max_size
+    )
+    lines = ["    (void)low;", "    (void)high;", "    (void)bounded;"]
+    for size, code in found:
+        value = _wire_value((False, size - first), sizes[command], e.endian == ">")
+        lines.append(f"    if (avail < {size}u) {{ return {P}__WAIT; }}")
+        lines.append(f"    if (({value}) == {code}u) {{ return {size}L; }} /* code {code} */")
+    return [*lines, f"    return {P}__NONE;"]
 
 
 def terminated_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout, overhead: int) -> list[str]:
@@ -930,17 +1012,24 @@ def source(ctx: Ctx) -> str:
     # the others; decoded from a frame of an error layout
     refusals = [(d, k) for d in directions(protocol) for k, a in enumerate(protocol.framing.alternatives[d]) if a.error]
     refusing_param = "int refusing, " if refusals else ""
+    chosen = protocol.framing.by_command  # layouts chosen by command: each message in its own layout alone
+    if chosen:
+        refusing_param += "uint8_t only, "
     skip_refusal = (
         f"\n        if ((L->error_flag == {ERROR_LAYOUT}UL) != (refusing != 0)) {{ /* an error header's layout */"
         "\n            continue;\n        }"
         if refusals
         else ""
     )
+    if chosen:
+        skip_refusal += (
+            "\n        if (k != only) { /* another command's layout (`layout:`) */\n            continue;\n        }"
+        )
     refused_fn, refused_call = refused_decoder(ctx, refusals)
     xargs = "present, extras, " if opt else ""
     for m in msgs:
         mid = msg_id(m)
-        layout = protocol.framing.layouts[m.direction]
+        layout = protocol.layout(m)
         values = value_elements(protocol, m.direction)
         number = protocol.command(m.command).wire_code(m.direction) if layout.has_command else None
         wire_code = f"{number if number is not None else 0}UL"
@@ -982,6 +1071,7 @@ def source(ctx: Ctx) -> str:
                     *([] if values else ["    values[0] = 0u;"]),
                     f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}"
                     + (f"{int(element is not None)}, " if refusals else "")
+                    + (f"{layout_index(protocol, m)}u, " if chosen else "")
                     + f"m, "
                     f"{p}__enc_{mid}, buf, cap, len);",
                     "}",
@@ -1041,6 +1131,55 @@ static size_t {p}__least({p}_direction_t dir)
         else ""
     )
     admits = f"{p}__admits(dir, k, frame, len)" if opt else "1"
+    taking = f"""    k = 0u;
+    if (!{P}__SINGLE && count != 1u) {{
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
+        for (k = 0u; k < count; k++) {{
+            size_t hl;
+            const uint8_t *h = {p}__header(dir, k, &hl);
+            if (hl <= len && {p}__same(frame, h, hl)) {{
+                headed = 1;
+                if ({admits}) {{
+                    break;
+                }}
+            }}
+        }}
+        if (k == count) {{
+            return headed ? {P}_E_LENGTH : {P}_E_FRAME;
+        }}
+    }}
+    r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
+    if (r != {P}_OK) {{
+        return r;
+    }}"""
+    if chosen:
+        # runtime/framing.py FrameCodec.unwrap: each layout whose header the frame starts with, in order; the refusal
+        # of the layout that sends the frame's code first, then any layout's, then a code sent in another layout
+        taking = f"""    {{
+        int problem = {P}_OK, elsewhere = {P}_OK;
+        for (k = 0u; k < count; k++) {{
+            size_t hl;
+            const uint8_t *h = {p}__header(dir, k, &hl);
+            if (hl > len || !{p}__same(frame, h, hl)) {{
+                continue;
+            }}
+            r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
+            if (r != {P}_OK) {{
+                if ({p}__sends_at(dir, k, frame, len)) {{
+                    return r;
+                }}
+                problem = problem != {P}_OK ? problem : r;
+                continue;
+            }}
+            if (!{p}__has_command(dir, k) || {p}__sends(dir, k, (long)code)) {{
+                break;
+            }}
+            elsewhere = elsewhere != {P}_OK ? elsewhere : {P}_E_UNKNOWN; /* a code sent in another layout */
+        }}
+        if (k == count) {{
+            return problem != {P}_OK ? problem : elsewhere != {P}_OK ? elsewhere : {P}_E_FRAME;
+        }}
+    }}"""
     admits_fn = optional.admits(ctx) if opt else ""
     extras_decl = f"\n    const uint8_t *extras[{optionals}];" if opt else ""
     find_extras = "\n    " + f"{p}__extras(dir, k, frame, len, extras);" if opt else ""
@@ -1112,7 +1251,7 @@ static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *co
 }}
 #endif
 #endif
-
+{chosen_functions(ctx)}
 {helpers}
 #if {P}_ENABLE_PARSER && {P}__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -1265,27 +1404,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
         return {P}_E_ARG;
     }}
     count = {p}__count(dir);{"" if both else no_layouts}
-    k = 0u;
-    if (!{P}__SINGLE && count != 1u) {{
-        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {{
-            size_t hl;
-            const uint8_t *h = {p}__header(dir, k, &hl);
-            if (hl <= len && {p}__same(frame, h, hl)) {{
-                headed = 1;
-                if ({admits}) {{
-                    break;
-                }}
-            }}
-        }}
-        if (k == count) {{
-            return headed ? {P}_E_LENGTH : {P}_E_FRAME;
-        }}
-    }}
-    r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
-    if (r != {P}_OK) {{
-        return r;
-    }}{find_extras}{refused_call}
+{taking}{find_extras}{refused_call}
     r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values,
                             {xarg}out);
     if (r != {P}_OK) {{
@@ -1767,12 +1886,11 @@ def switch_cases(cases: list[str], closed: bool, otherwise: str) -> str:
 def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:
     """A direction's messages by the command code their frames carry (None: the layout carries none; ERROR_CODE:
     the error reply)."""
-    layout = protocol.framing.layouts[direction]
     found: dict[int | None, list[Message]] = {}
     for m in messages(protocol):
         if m.direction == direction:
             wire = protocol.command(m.command).wire_code(direction)
-            code = ERROR_CODE if m.error_reply else wire if layout.has_command else None
+            code = ERROR_CODE if m.error_reply else wire if protocol.layout(m).has_command else None
             found.setdefault(code, []).append(m)
     return found
 

@@ -807,7 +807,7 @@ CASES[BY_COMMAND] = Case(
     },
 )
 # each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
-C_REFUSES[BY_COMMAND] = WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
+WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
 # Layouts chosen by command, one with a command element and one without (TFmini: configuration frames 42 57 02 00,
 # parameters, the command byte last; data frames 59 59 with no command): a codeless command travels in its own layout
 MIXED = "frame: layouts chosen by command, one without a command element, the command byte after the content"
@@ -842,7 +842,7 @@ CASES[MIXED] = Case(
         "measure": {"layout": "data", "request": {}, "response": {"fields": {"distance": "u16", "strength": "u16"}}},
     },
 )
-C_REFUSES[MIXED] = WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
+WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
 
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a
@@ -1058,6 +1058,7 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
                         for fields in st_examples(message_fields(g.protocol, message), 3):
                             frames.append(agrees_with_python(run, g, message, fields))
                 stream_agrees_with_python(run, g, direction, b"\x00\x01".join(frames) + b"\x02", "1,3,0,7")
+                awaited_streams(run, g, direction)
                 for element in g.protocol.framing.layouts[direction].optional:
                     # each message with the optional element sent and not, the frames back to back, in any split
                     both = [
@@ -1070,6 +1071,24 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
             crafted(run, g, name)
         finally:
             run.close()
+
+
+def awaited_streams(run: Any, g: Generated, direction: Direction) -> None:
+    """Replies read with their request: for each reply, frames of it answering one request among garbage, the C
+    parser awaiting it (parser_expect_reply) as the Python parser does (expect(cls, request))."""
+    from conftest import a_request, needs_request
+    from test_c_backend import agrees_with_python, stream_agrees_with_python
+
+    for message in g.protocol.messages():
+        if message.direction != direction or not needs_request(g, message):
+            continue
+        request = a_request(g, message)
+        frames = [
+            agrees_with_python(run, g, message, fields, request)
+            for fields in st_examples(message_fields(g.protocol, message), 2)
+        ]
+        stream = b"\x00".join(frames) + b"\x80" + frames[0][:-1]
+        stream_agrees_with_python(run, g, direction, stream, "1,4,2", message, request=request)
 
 
 def c_source(built: Built, tmp_path: Path) -> Path:

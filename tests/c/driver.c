@@ -14,6 +14,9 @@
  *                            answer: "args <result or text> ..." (one line)
  *   kinds DIR                every kind encoded from a zeroed message: "kinds <kind>=<result> ..." (one line)
  *   each DIR                 with -DDRIVER_EACH="file": the file's each_encoder() (every message's own encoder called)
+ *   req DIR HEX|-            with -DDRIVER_REPLIES (a protocol whose replies are read with their request): the request
+ *                            frame HEX decoded, then given to every reply's decode, encode and parser_expect
+ *                            (p_decode_reply, p_encode_reply, p_parser_expect_reply) until "req DIR -": "ok"/"err <r>"
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +27,17 @@
 #define P(name) CAT(PROTO, CAT(_, name))
 
 static P(msg_t) msg;
+#ifdef DRIVER_REPLIES
+static P(msg_t) request;
+static int asked = 0;
+#define DECODE(f, n, d, kind, m) \
+    (asked && (d) == CAT(PROTO_UPPER, _RESPONSE) ? P(decode_reply)(f, n, &request, m) : P(decode_expect)(f, n, d, kind, m))
+#define ENCODE(m, d, b, cap, len) \
+    (asked && (d) == CAT(PROTO_UPPER, _RESPONSE) ? P(encode_reply)(m, &request, b, cap, len) : P(encode)(m, b, cap, len))
+#else
+#define DECODE(f, n, d, kind, m) P(decode_expect)(f, n, d, kind, m)
+#define ENCODE(m, d, b, cap, len) P(encode)(m, b, cap, len)
+#endif
 static P(parser_t) parser;
 static uint8_t frame[1 << 17];
 static uint8_t out[1 << 17];
@@ -110,9 +124,9 @@ int main(void)
             size_t n = unhex(hex ? hex : "", frame, sizeof(frame));
             int r;
             if (strcmp(cmd, "enc1") == 0) {
-                r = P(decode)(frame, n, dir, &msg);
+                r = DECODE(frame, n, dir, CAT(PROTO_UPPER, _KIND_NONE), &msg);
             } else {
-                r = P(decode_expect)(frame, n, dir, kind_of(extra), &msg);
+                r = DECODE(frame, n, dir, kind_of(extra), &msg);
             }
             if (r != 0) {
                 printf("err %s\n", P(result_name)(r));
@@ -125,7 +139,7 @@ int main(void)
                     cap = (size_t)strtoul(extra ? extra : "0", NULL, 10);
                 }
                 memset(out, 0xA5, cap + 64u);
-                r = P(encode)(&msg, out, cap, &len);
+                r = ENCODE(&msg, dir, out, cap, &len);
                 for (i = cap; i < cap + 64u; i++) {
                     if (out[i] != 0xA5) {
                         printf("overrun\n");
@@ -187,6 +201,11 @@ int main(void)
             P(parser_init)(&parser, dir);
             if (expect != NULL && strcmp(expect, "-") != 0) {
                 P(parser_expect)(&parser, kind_of(expect));
+#ifdef DRIVER_REPLIES
+                if (asked) {
+                    P(parser_expect_reply)(&parser, &request);
+                }
+#endif
             }
             while (at <= n) {
                 size_t take = piece[which++ % npieces];
@@ -229,6 +248,22 @@ int main(void)
             }
             printf("end %lu %lu %lu %lu\n", (unsigned long)parser.frames, (unsigned long)parser.garbage,
                    (unsigned long)parser.errors, (unsigned long)parser.n);
+#ifdef DRIVER_REPLIES
+        } else if (strcmp(cmd, "req") == 0) {
+            char *hex = strtok(NULL, " \n");
+            int r = 0;
+            asked = 0;
+            if (hex != NULL && strcmp(hex, "-") != 0) {
+                size_t n = unhex(hex, frame, sizeof(frame));
+                r = P(decode)(frame, n, CAT(PROTO_UPPER, _REQUEST), &request);
+                asked = r == 0;
+            }
+            if (r != 0) {
+                printf("err %s\n", P(result_name)(r));
+            } else {
+                printf("ok\n");
+            }
+#endif
         } else if (strcmp(cmd, "args") == 0) {
             size_t len = 1u;
             bool got = true;

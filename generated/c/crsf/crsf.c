@@ -823,6 +823,15 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         case 30L:
             size = 6L;
             return size;
+        case 33L: {
+            size_t i;
+            for (i = 0u; i < avail; i++) {
+                if (c[i] == 0u) {
+                    return (long)(i + 1u);
+                }
+            }
+            return CRSF__WAIT;
+        }
         case 40L:
             size = 2L;
             return size;
@@ -846,6 +855,15 @@ static long crsf__content_size(crsf_direction_t dir, long code, const uint8_t *c
         case 30L:
             size = 6L;
             return size;
+        case 33L: {
+            size_t i;
+            for (i = 0u; i < avail; i++) {
+                if (c[i] == 0u) {
+                    return (long)(i + 1u);
+                }
+            }
+            return CRSF__WAIT;
+        }
         default:
             return CRSF__NONE;
         }

@@ -18,7 +18,7 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
-from serialspec.backends.common.frames import refuse_by_command, refuse_code_forms
+from serialspec.backends.common.frames import refuse_code_forms
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
 from serialspec.encodings import bit_run, seven_bit
@@ -216,7 +216,7 @@ class Ctx:
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
-    refuse_by_command(protocol)
+    refuse_by_request(protocol)
     refuse_code_forms(protocol)
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
@@ -227,6 +227,30 @@ def refuse_unsupported(protocol: Protocol) -> None:
     for message in protocol.messages():
         refuse_fields(message.fields, message.key)
     refuse_wide_values(protocol)
+
+
+def refuse_by_request(protocol: Protocol) -> None:
+    """Unsupported for frames the C decoder cannot read alone. Layouts chosen by command (`layout:`) generate where
+    every frame still says how to read it (a header, or a code sent in one layout alone)."""
+    framing = protocol.framing
+    if framing.by_request(Direction.RESPONSE) and not framing.by_command:
+        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
+    if framing.from_request and (framing.classic or any(layout.transparency for layout in every_layout(protocol))):
+        raise Unsupported("a reply checksum over bytes of its request (`from_request`) in a classic or stuffed frame")
+    if not framing.by_command:
+        return
+    for direction, layouts in framing.alternatives.items():
+        values = {tuple((e.name, e.type) for e in layout.value_elements) for layout in layouts}
+        if len(values) > 1:
+            raise Unsupported(f"layouts chosen by command with different frame values ({direction.value} frames)")
+        if any(layout.transparency is not None or layout.optional for layout in layouts):
+            raise Unsupported(
+                f"layouts chosen by command with a frame transform or optional elements ({direction.value} frames)"
+            )
+
+
+def every_layout(protocol: Protocol) -> list[FrameLayout]:
+    return [layout for layouts in protocol.framing.alternatives.values() for layout in layouts]
 
 
 def refuse_layout(layout: FrameLayout) -> None:

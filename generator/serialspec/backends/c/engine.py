@@ -712,3 +712,37 @@ def with_skips(engine: str, skips: bool) -> str:
 
 
 ENGINE = HEAD + GET + TAIL
+
+
+# A reply checksum over bytes of its request (`from_request`): wrap takes the request's bytes (pre, pre_n; NULL: none
+# given) and a checksum element whose has_also is set takes them in first. Put in only where a spec has one.
+WRAP_SIGNATURE = "const uint32_t *values, const uint8_t *const *extras, size_t *len)"
+WRAP_CHECKSUM = "pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, bytes, sz));"
+TAKEN = r"""if (e->has_also) { /* the request's bytes first (`from_request`), then the span */
+                uint8_t taken[PFX_REQUEST_BYTES + PFX_MAX_FRAME];
+                size_t m = 0u, j;
+                if (pre == NULL) {
+                    return PFX_E_ARG; /* a reply whose checksum takes in its request's bytes: give the request */
+                }
+                if (sz > PFX_MAX_FRAME || pre_n > PFX_REQUEST_BYTES) {
+                    return PFX_E_CAPACITY;
+                }
+                for (j = 0u; j < pre_n; j++) {
+                    taken[m++] = pre[j];
+                }
+                for (j = 0u; j < sz; j++) {
+                    taken[m++] = bytes[j];
+                }
+                pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, taken, m));
+                continue;
+            }
+            """
+
+
+def with_request(engine: str) -> str:
+    """The engine whose wrap takes the request's bytes for reply checksums over them."""
+    assert engine.count(WRAP_SIGNATURE) == 1 and engine.count(WRAP_CHECKSUM) == 1
+    engine = engine.replace(
+        WRAP_SIGNATURE, WRAP_SIGNATURE[:-1] + ",\n                     const uint8_t *pre, size_t pre_n)"
+    )
+    return engine.replace(WRAP_CHECKSUM, TAKEN + WRAP_CHECKSUM)

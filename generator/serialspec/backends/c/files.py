@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from serialspec import __version__
 from serialspec.backends.c import length_byte, optional, packed, parser_api
+from serialspec.backends.c import requests as asking
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
@@ -24,11 +25,21 @@ from serialspec.backends.c.emit import (
     spec_hash,
     value_elements,
 )
-from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, with_skips
+from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, with_request, with_skips
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
-from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
+from serialspec.backends.common.frames import layout_codes, layout_index
+from serialspec.lang.model import (
+    VALUE_ROLES,
+    Direction,
+    FrameElement,
+    FrameLayout,
+    Message,
+    Protocol,
+    nul_ended,
+    size_terms,
+)
 from serialspec.transforms.replace import Replace
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
@@ -173,6 +184,15 @@ def header(ctx: Ctx) -> str:
     expect_member = (
         "" if protocol.framing.classic else f"    {p}_kind_t expect;                 /* {p}_parser_expect */\n"
     )
+    request_members = request_api = request_define = ""
+    if asking.asks(protocol):  # replies read with their request: the API takes it, the parser keeps its bytes
+        request_members = asking.parser_members(ctx)
+        most = asking.request_bytes(ctx)[1]
+        request_api = asking.prototypes(ctx)
+        request_define = (
+            f"\n/* The most bytes of a request that its reply's checksum takes in (`from_request`). */\n"
+            f"#define {P}_REQUEST_BYTES {most}u\n"
+        )
     expect_doc = (
         "The reply the next frames answer (Python's StreamParser.expect()): classic frames have one layout\n"
         " * a code, so it changes nothing here."
@@ -181,6 +201,7 @@ def header(ctx: Ctx) -> str:
         f" * decoded as {p}_decode_expect(..., reply, ...) decodes them where replies share a code;\n"
         f" * {P}_KIND_NONE: the spec's default."
     )
+    parser_members = expect_member + request_members
     return f"""{banner(protocol)}
 #ifndef {guard}
 #define {guard}
@@ -260,7 +281,7 @@ typedef struct {{
     }} u;
 }} {p}_msg_t;
 
-{parser_api.event_type(p, P)}
+{parser_api.event_type(p, P) + request_define}
 /* The stream parser's whole state, owned by the caller (no globals): one per byte stream and direction. */
 typedef struct {{
     {p}_direction_t dir;
@@ -272,7 +293,7 @@ typedef struct {{
 {wake}
     const uint8_t *frame;             /* the last frame delivered, as received ({p}_parser_frame) */
     size_t frame_len;
-{expect_member}    uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
+{parser_members}    uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
 {verdict}{unknown_frame}
 }} {p}_parser_t;
 
@@ -301,7 +322,7 @@ void {p}_parser_gap({p}_parser_t *parser);
 const uint8_t *{p}_parser_frame(const {p}_parser_t *parser, size_t *len);
 /* {expect_doc} */
 void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply);
-
+{request_api}
 /* Names: a kind's ("ping_request"), a result's ("E_CHECKSUM"). */
 const char *{p}_kind_name({p}_kind_t kind);
 const char *{p}_result_name(int result);
@@ -368,9 +389,11 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             minimum = sum(1 << names.index(name) for name in e.checksum.skips)
         maximum = int(e.maximum) if value else 0
         also = e.broadcast if value and e.broadcast is not None else None
+        # (a checksum's has_also: 1 when it takes in the request's bytes first, `from_request`)
+        taken = e.checksum is not None and bool(e.checksum.from_request)
         rows.append(
             f"    {{{p.upper()}__ROLE_{role}, {size}u, {1 if e.endian == '>' else 0}u, {first}u, {last}u, {check}u, "
-            f"{0 if also is None else 1}u, {e.adds}L, {minimum}UL, {maximum}UL, {also or 0}UL, {constant}}},"
+            f"{int(also is not None or taken)}u, {e.adds}L, {minimum}UL, {maximum}UL, {also or 0}UL, {constant}}},"
             f"  /* {e.name} */"
         )
     lines.append(f"static const {p}__element_t {name}_e[] = {{\n" + "\n".join(rows) + "\n};")
@@ -415,6 +438,58 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
     return "\n".join(lines), name
+
+
+def chosen_functions(ctx: Ctx) -> str:
+    """Layouts chosen by command (`layout:`): which codes each layout sends ({p}__sends), and whether a frame carries,
+    at its layout's fixed command offset, a code that layout sends ({p}__sends_at: runtime/framing.py _code_at, for
+    FrameCodec.unwrap's choice of whose refusal counts). "" for other protocols."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    if not protocol.framing.by_command:
+        return ""
+    sends: list[str] = []
+    at: list[str] = []
+    for d in directions(protocol):
+        for k, layout in enumerate(protocol.framing.alternatives[d]):
+            codes = layout_codes(protocol, layout)
+            if codes is None:
+                continue
+            test = " || ".join(f"code == {c}L" for c in codes) or "0"
+            sends.append(f"    if (dir == {P}_{d.name} && k == {k}u) {{\n        return {test};\n    }}")
+            index = next(i for i, e in enumerate(layout.elements) if e.role == "command")
+            content = next((i for i, e in enumerate(layout.elements) if e.role == "content"), len(layout.elements))
+            if index < content:
+                e = layout.elements[index]
+                offset = sum(x.size or 0 for x in layout.elements[:index])
+                value = _wire_value((False, offset), e.size or 0, e.endian == ">")
+                at.append(
+                    f"    if (dir == {P}_{d.name} && k == {k}u) {{\n"
+                    f"        return n >= {offset + (e.size or 0)}u && {p}__sends(dir, k, (long)({value}));\n    }}"
+                )
+    return f"""
+#if {P}_ENABLE_DECODE
+/* Layouts chosen by command (`layout:`): 1 when the direction's layout k sends code `code` (a layout without a
+ * command element sends every message it is chosen for). */
+static int {p}__sends({p}_direction_t dir, uint8_t k, long code)
+{{
+    (void)code;
+{chr(10).join(sends)}
+    return 1;
+}}
+
+/* 1 when frame f[0..n) reaches layout k's command element (at its fixed offset) and carries a code the layout sends:
+ * that layout's refusal is the frame's (runtime/framing.py FrameCodec.unwrap). */
+static int {p}__sends_at({p}_direction_t dir, uint8_t k, const uint8_t *f, size_t n)
+{{
+    (void)dir;
+    (void)k;
+    (void)f;
+    (void)n;
+{chr(10).join(at)}
+    return 0;
+}}
+#endif
+"""
 
 
 def every_layout(protocol: Protocol) -> list[FrameLayout]:
@@ -498,9 +573,11 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     prefix = _prefix(ctx, layout)
     error = ctx.protocol.error_reply
     flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
+    wanted = asking.by_reply(ctx.protocol, direction)  # no code: sized as the reply awaited (`want`, its kind)
     lines = [
         f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: probe, straight line. */",
-        f"static long {p}__probe_{direction.value}_{k}(const uint8_t *f, size_t avail)",
+        f"static long {p}__probe_{direction.value}_{k}(const uint8_t *f, size_t avail"
+        + (", long want)" if wanted else ")"),
         "{",
         "    size_t low = 0u, high = 0u;",
         "    int bounded = 0;",
@@ -528,12 +605,30 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             lines.append(
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
             )
+            if layout_codes(ctx.protocol, layout) is not None:  # layouts chosen by command: a code sent in it
+                lines.append(f"    if (!{p}__sends({P}_{direction.name}, {k}u, code)) {{ return {P}__NONE; }}")
         elif e.role in VALUE_ROLES:
             test = _range_test(e, "v", sizes[i], _need(ctx, direction, k, e))
             if test is not None:
                 lines.append(f"    {{ uint32_t v = {value}; if ({test}) {{ return {P}__NONE; }} }} /* {e.name} */")
         offset = stop
-    if command < 0:
+    if command < 0 and wanted:  # only the replies of this layout, the one awaited
+        kinds = [
+            kind_name(ctx, m)
+            for m in messages(ctx.protocol)
+            if m.direction == direction and ctx.protocol.layout(m).name == layout.name
+        ]
+        lines += [
+            "    switch (want) {",
+            *(f"    case {kind}:" for kind in kinds),
+            "        break;",
+            "    default:",
+            f"        return {P}__NONE; /* no reply awaited, or one of another layout */",
+            "    }",
+            "    code = want;",
+            f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}",
+        ]
+    elif command < 0:
         lines.append(
             f"    if (!{p}__bounds({P}_{direction.name}, {P}__NO_CODE, &low, &high, &bounded)) {{ return {P}__NONE; }}"
         )
@@ -551,6 +646,8 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             f"      if (content < (long)low || (bounded && content > (long)high)) {{ return {P}__NONE; }}",
             f"      return {sum(sizes) - counted}L + counted; }}",
         ]
+    elif command > first and elements[-1].role not in ("header", "trailer", "constant"):
+        lines += trailing_probe(ctx, direction, layout, sizes, command)
     else:
         lines += terminated_probe(ctx, direction, k, layout, sum(sizes))
         lines += [
@@ -563,6 +660,31 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     return "\n".join(lines)
 
 
+def trailing_probe(ctx: Ctx, direction: Direction, layout: FrameLayout, sizes: list[int], command: int) -> list[str]:
+    """The probe's lines for a frame whose command element follows a content of one size per code, with no length
+    or trailer to size it (TFmini's configuration frames): the smallest frame size whose code is in the command
+    element there (runtime/framing.py _by_trailing_code)."""
+    P = ctx.P
+    codes = layout_codes(ctx.protocol, layout)
+    e = layout.elements[command]
+    first = sum(sizes[command:])
+    found = sorted(
+        (sum(sizes) + users[0].min_size, code)
+        for code, users in messages_by_code(ctx.protocol, direction).items()
+        if code is not None
+        and code >= 0
+        and (codes is None or code in codes)
+        and len({(u.min_size, u.max_size) for u in users}) == 1
+        and users[0].min_size == users[0].max_size
+    )
+    lines = ["    (void)low;", "    (void)high;", "    (void)bounded;"]
+    for size, code in found:
+        value = _wire_value((False, size - first), sizes[command], e.endian == ">")
+        lines.append(f"    if (avail < {size}u) {{ return {P}__WAIT; }}")
+        lines.append(f"    if (({value}) == {code}u) {{ return {size}L; }} /* code {code} */")
+    return [*lines, f"    return {P}__NONE;"]
+
+
 def terminated_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout, overhead: int) -> list[str]:
     """The probe's lines for a frame ended by its trailer with nothing else to size it (no length, no transform, a
     code with no size rule): the first occurrence of the trailer at which the frame checks (this layout's unwrap:
@@ -572,17 +694,15 @@ def terminated_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout
     last = layout.elements[-1]
     if len(layout.elements) < 2 or last.role not in ("header", "trailer", "constant"):
         return []
-    ruled = [
-        code_key(P, code)
-        for code, users in messages_by_code(ctx.protocol, direction).items()
-        if len(users) == 1 and size_terms(users[0].fields) is not None
-    ]
-    if len(ruled) == len(messages_by_code(ctx.protocol, direction)):
+    keys = probe_keys(ctx, direction)
+    ruled = [key for key, users in keys if len(users) == 1 and size_terms(users[0].fields) is not None]
+    if len(ruled) == len(keys):
         return []  # every code's content is sized by its own leading fields
     trailer = last.constant
     found = " && ".join(f"f[i + {j}u] == 0x{byte:02x}u" for j, byte in enumerate(trailer))
     unwrap = f"{p}__unwrap_{direction.value}_{k}(f, i + {len(trailer)}u, &c, v, &content, &clen"
-    unwrap += ", 0)" if length_byte.applies(ctx.protocol) else ")"
+    unwrap += ", 0" if length_byte.applies(ctx.protocol) else ""
+    unwrap += ", NULL, 0u)" if asking.asks(ctx.protocol) else ")"
     return [
         f"    if ({' && '.join(f'code != {key}' for key in ruled) or '1'}) {{",
         "        /* no size rule: the frame ends at the first trailer at which it checks */",
@@ -642,16 +762,23 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
     # candidate it sized, whose header, values before the content (their ranges) and length it checked already.
     sized = length_byte.applies(ctx.protocol)
     skip = "!sized && " if sized else ""
+    pre = ", const uint8_t *pre, size_t pre_n" if asking.asks(ctx.protocol) else ""
     lines = [
         f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: unwrap, straight line"
         + ("; sized: the stream parser checked its header, values and length already. */" if sized else ". */"),
         f"static int {p}__unwrap_{direction.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,",
-        "                                 const uint8_t **content, size_t *clen" + (", int sized)" if sized else ")"),
+        "                                 const uint8_t **content, size_t *clen"
+        + (", int sized" if sized else "")
+        + pre
+        + ")",
         "{",
         "    (void)values;",
+        *(["    (void)pre;", "    (void)pre_n;"] if pre else []),
         "    *code = 0u;",
     ]
-    if before + after:  # (a layout of content alone: any size, and `n < 0u` is a -Wtype-limits error)
+    if content < 0:  # no content: its fixed elements alone, exactly (a bare acknowledgement, a read request)
+        lines += [f"    if ({skip}n != {before + after}u) {{", f"        return {P}_E_LENGTH;", "    }"]
+    elif before + after:  # (a layout of content alone: any size, and `n < 0u` is a -Wtype-limits error)
         lines += [f"    if ({skip}n < {before + after}u) {{", f"        return {P}_E_LENGTH;", "    }"]
     for i, e in enumerate(elements):
         if e.role in ("header", "trailer", "constant"):
@@ -696,6 +823,18 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
             value = _wire_value(start[i], sizes[i], e.endian == ">")
+            if e.checksum.from_request:  # the request's bytes first (runtime Layout.unwrap's _requested), then its span
+                lines += [
+                    f"    {{ uint8_t taken[{P}_REQUEST_BYTES + {P}_MAX_FRAME]; /* {e.name}: the request's "
+                    f"{', '.join(e.checksum.from_request)} first */",
+                    "      size_t m = 0u, i;",
+                    f"      if (pre == NULL) {{ return {P}_E_ARG; }} /* no request given: it cannot be checked */",
+                    f"      if (n > {P}_MAX_FRAME || pre_n > {P}_REQUEST_BYTES) {{ return {P}_E_CAPACITY; }}",
+                    "      for (i = 0u; i < pre_n; i++) { taken[m++] = pre[i]; }",
+                    f"      for (i = {at(start[a])}; i < {at(end[b])}; i++) {{ taken[m++] = f[i]; }}",
+                    f"      if ({p}__check({check}u, taken, m) != ({value})) {{ return {P}_E_CHECKSUM; }} }}",
+                ]
+                continue
             if e.checksum.skips:  # its span less the elements it leaves out, gathered (runtime Layout._covered)
                 left = {names.index(name) for name in e.checksum.skips}
                 runs: list[tuple[int, int]] = []
@@ -729,6 +868,13 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
 
 def source(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    # replies read with their request: sized as the reply awaited (want), checked with the request's bytes (pre)
+    wanting = any(asking.by_reply(protocol, d) for d in directions(protocol))
+    want_param, want_void, want_arg = ("", "", "")
+    if wanting:
+        want_param, want_void, want_arg = (", long want", "\n    (void)want;", ", (long)p->expect")
+    asks = asking.asks(protocol)
+    pre_param, pre_arg = (", const uint8_t *pre, size_t pre_n", ", pre, pre_n") if asks else ("", "")
     msgs = messages(protocol)
     tables: list[str] = []
     layout_lists: list[str] = []
@@ -779,7 +925,8 @@ def source(ctx: Ctx) -> str:
                 probes.append(straight_probe(ctx, d, k, layout))
                 if "__unwrap_" in probes[-1]:  # ended by its trailer: the probe calls the unwrap defined below
                     terminated.append((d, k))
-                prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail);")
+                want = ", want" if asking.by_reply(protocol, d) else ""
+                prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail{want});")
         # each direction's headers as a table by layout (NULL, 0: none); k is below the direction's count
         heads = [f"{p}__h_{d.value}_{k}" if layout.header else "NULL" for k, layout in enumerate(alternatives)]
         sizes = [f"{len(layout.header)}u" for layout in alternatives]
@@ -803,7 +950,8 @@ def source(ctx: Ctx) -> str:
                 rows.append(
                     f"        case {k}u:\n"
                     f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen"
-                    + (", 0);" if length_byte.applies(protocol) else ");")
+                    + (", 0" if length_byte.applies(protocol) else "")
+                    + f"{pre_arg});"
                 )
         every_k = len(rows) == len(alternatives)
         unwrapped = unwrapped and every_k
@@ -840,20 +988,20 @@ def source(ctx: Ctx) -> str:
     engine = with_inner_lengths(
         engine, any(plain_span(layout) for layout in every_layout(protocol)), transform_prefixes(protocol, p)
     )
+    if asks:
+        engine = with_request(engine)
     engine = engine.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
     engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks
     bounds_cases: list[str] = []
     for d in directions(protocol):
-        by_code = messages_by_code(protocol, d)
         rows = []
-        for code, users in by_code.items():
+        for key, users in probe_keys(ctx, d):
             low = min(u.min_size for u in users)
             highs = [u.max_size for u in users]
             high = None if None in highs else max(h or 0 for h in highs)
             if high is not None and high > 0xFFFFFFFF:  # a size read from a u64 field: bounds nothing a frame holds
                 high = None
-            key = code_key(P, code)
             rows.append(
                 f"        case {key}: *low = {low}u; *high = {high or 0}u; *bounded = {0 if high is None else 1}; "
                 "return 1;"
@@ -930,17 +1078,24 @@ def source(ctx: Ctx) -> str:
     # the others; decoded from a frame of an error layout
     refusals = [(d, k) for d in directions(protocol) for k, a in enumerate(protocol.framing.alternatives[d]) if a.error]
     refusing_param = "int refusing, " if refusals else ""
+    chosen = protocol.framing.by_command  # layouts chosen by command: each message in its own layout alone
+    if chosen:
+        refusing_param += "uint8_t only, "
     skip_refusal = (
         f"\n        if ((L->error_flag == {ERROR_LAYOUT}UL) != (refusing != 0)) {{ /* an error header's layout */"
         "\n            continue;\n        }"
         if refusals
         else ""
     )
+    if chosen:
+        skip_refusal += (
+            "\n        if (k != only) { /* another command's layout (`layout:`) */\n            continue;\n        }"
+        )
     refused_fn, refused_call = refused_decoder(ctx, refusals)
     xargs = "present, extras, " if opt else ""
     for m in msgs:
         mid = msg_id(m)
-        layout = protocol.framing.layouts[m.direction]
+        layout = protocol.layout(m)
         values = value_elements(protocol, m.direction)
         number = protocol.command(m.command).wire_code(m.direction) if layout.has_command else None
         wire_code = f"{number if number is not None else 0}UL"
@@ -966,11 +1121,20 @@ def source(ctx: Ctx) -> str:
                     cond = f"({cond}) && m->{ident(name)} != {e.broadcast}u"
                 vchecks.append(f"    if ({cond}) {{ return {P}_E_RANGE; }} /* {name} */")
             vsets.append(f"    values[{i}] = (uint32_t)m->{ident(name)};")
+        # replies read with their request: the frame made with the request's bytes (pre) by {p}__encode_<m>, which
+        # {p}_encode_reply calls; the public encoder gives none
+        inner = asks and m.direction == Direction.RESPONSE
+        signature = f"int {p}_encode_{mid}(const {p}_{mid}_t *m, uint8_t *buf, size_t cap, size_t *len)"
+        if inner:
+            signature = (
+                f"static int {p}__encode_{mid}(const {p}_{mid}_t *m, const uint8_t *pre, size_t pre_n, uint8_t *buf,\n"
+                f"                        size_t cap, size_t *len)"
+            )
         pub_encoders.append(
             "\n".join(
                 [
                     f"/* {m.key} ({m.direction.value}): the frame of one message. */",
-                    f"int {p}_encode_{mid}(const {p}_{mid}_t *m, uint8_t *buf, size_t cap, size_t *len)",
+                    signature,
                     "{",
                     f"    uint32_t values[{max(1, len(values))}];",
                     *xdecls,
@@ -982,13 +1146,21 @@ def source(ctx: Ctx) -> str:
                     *([] if values else ["    values[0] = 0u;"]),
                     f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, {xargs}"
                     + (f"{int(element is not None)}, " if refusals else "")
+                    + (f"{layout_index(protocol, m)}u, " if chosen else "")
                     + f"m, "
-                    f"{p}__enc_{mid}, buf, cap, len);",
+                    f"{p}__enc_{mid}, buf, cap, len"
+                    + (", pre, pre_n" if inner else ", NULL, 0u" if asks else "")
+                    + ");",
                     "}",
                     "",
                 ]
             )
         )
+        if inner:
+            pub_encoders.append(
+                f"int {p}_encode_{mid}(const {p}_{mid}_t *m, uint8_t *buf, size_t cap, size_t *len)\n"
+                f"{{\n    return {p}__encode_{mid}(m, NULL, 0u, buf, cap, len);\n}}\n"
+            )
     enc_cases = "\n".join(
         f"#if {P}_ENCODES_{m.direction.name}S\n"
         f"    case {kind_name(ctx, m)}:\n        return {p}_encode_{msg_id(m)}(&msg->u.{msg_id(m)}, buf, cap, len);\n"
@@ -1041,7 +1213,93 @@ static size_t {p}__least({p}_direction_t dir)
         else ""
     )
     admits = f"{p}__admits(dir, k, frame, len)" if opt else "1"
+    taking = f"""    k = 0u;
+    if (!{P}__SINGLE && count != 1u) {{
+        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
+        for (k = 0u; k < count; k++) {{
+            size_t hl;
+            const uint8_t *h = {p}__header(dir, k, &hl);
+            if (hl <= len && {p}__same(frame, h, hl)) {{
+                headed = 1;
+                if ({admits}) {{
+                    break;
+                }}
+            }}
+        }}
+        if (k == count) {{
+            return headed ? {P}_E_LENGTH : {P}_E_FRAME;
+        }}
+    }}
+    r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
+    if (r != {P}_OK) {{
+        return r;
+    }}"""
+    if chosen:
+        # runtime/framing.py FrameCodec.unwrap: each layout whose header the frame starts with, in order; the refusal
+        # of the layout that sends the frame's code first, then any layout's, then a code sent in another layout
+        taking = f"""    {{
+        int problem = {P}_OK, elsewhere = {P}_OK;
+        for (k = 0u; k < count; k++) {{
+            size_t hl;
+            const uint8_t *h = {p}__header(dir, k, &hl);
+            if (hl > len || !{p}__same(frame, h, hl)) {{
+                continue;
+            }}
+            r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
+            if (r != {P}_OK) {{
+                if ({p}__sends_at(dir, k, frame, len)) {{
+                    return r;
+                }}
+                problem = problem != {P}_OK ? problem : r;
+                continue;
+            }}
+            if (!{p}__has_command(dir, k) || {p}__sends(dir, k, (long)code)) {{
+                break;
+            }}
+            elsewhere = elsewhere != {P}_OK ? elsewhere : {P}_E_UNKNOWN; /* a code sent in another layout */
+        }}
+        if (k == count) {{
+            return problem != {P}_OK ? problem : elsewhere != {P}_OK ? elsewhere : {P}_E_FRAME;
+        }}
+    }}"""
+        if asking.by_reply(protocol, Direction.RESPONSE):
+            # replies carry no code: the layout of the reply awaited (FrameCodec.unwrap with `replies`); the one
+            # layout where none is awaited and there is one
+            taking = f"""    if (dir == {P}_RESPONSE) {{
+        int at = {p}__reply_layout(expect);
+        if (at < 0 && !(expect == {P}_KIND_NONE && count == 1u)) {{
+            return {P}_E_ARG; /* no reply awaited, or a kind that is no reply */
+        }}
+        k = at < 0 ? 0u : (uint8_t)at;
+        r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
+        if (r != {P}_OK) {{
+            return r;
+        }}
+    }} else {taking.lstrip()}"""
     admits_fn = optional.admits(ctx) if opt else ""
+    unwrap_tail = "const uint8_t **content, size_t *clen"
+    if asks:
+        unwrap_tail = "const uint8_t **content,\n                          size_t *clen" + pre_param
+    request_functions = ""
+    if asks:
+        request_functions = asking.request_bytes(ctx)[0]
+        if wanting:
+            request_functions += f"\n#if {P}_ENABLE_DECODE{asking.reply_layout(ctx)}#endif\n"
+    decode_head = f"int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, "
+    decode_head += f"{p}_msg_t *out)"
+    decode_tail = ""
+    public_head = decode_head
+    if asks:  # the decoder with the request's bytes (pre, NULL: none given), for decode_expect, decode_reply, parser
+        decode_head = (
+            f"static int {p}__decode_with(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect,\n"
+            f"                            const uint8_t *pre, size_t pre_n, {p}_msg_t *out)"
+        )
+        decode_tail = f"""{public_head}
+{{
+    return {p}__decode_with(frame, len, dir, expect, NULL, 0u, out);
+}}
+{asking.functions(ctx)[0]}
+"""
     extras_decl = f"\n    const uint8_t *extras[{optionals}];" if opt else ""
     find_extras = "\n    " + f"{p}__extras(dir, k, frame, len, extras);" if opt else ""
     all_lengths = int(all(layout.length is not None for layout in every))
@@ -1112,7 +1370,7 @@ static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *co
 }}
 #endif
 #endif
-
+{chosen_functions(ctx)}{request_functions}
 {helpers}
 #if {P}_ENABLE_PARSER && {P}__SIZED
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -1144,7 +1402,8 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     probing += "".join(
         f"static int {p}__unwrap_{d.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,\n"
         "                                 const uint8_t **content, size_t *clen"
-        + (", int sized);\n" if length_byte.applies(protocol) else ");\n")
+        + (", int sized" if length_byte.applies(protocol) else "")
+        + f"{pre_param});\n"
         for d, k in terminated
     )
     no_layouts = f"""
@@ -1186,8 +1445,8 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
     probing += f"""{chr(10).join(probes)}
 /* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when
  * none starts there. */
-static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
-{{
+static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail{want_param})
+{{{want_void}
     switch (dir) {{
 {switch_cases(probe_cases, probed, "    default:" + chr(10) + "        break;")}
     }}{"" if probed else probe_rest}
@@ -1226,10 +1485,10 @@ static int {p}__has_command({p}_direction_t dir, uint8_t k)
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 {chr(10).join(straight)}
 static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
-                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+                          uint8_t *plain, uint32_t *code, uint32_t *values, {unwrap_tail})
 {{
     (void)k;
-    (void)plain;
+    (void)plain;{"" if not asks else chr(10) + "    (void)pre;" + chr(10) + "    (void)pre_n;"}
     switch (dir) {{
 {switch_cases(unwrap_cases, unwrapped, "    default:" + chr(10) + "        break;")}
     }}{"" if unwrapped else unwrap_rest}
@@ -1249,7 +1508,7 @@ static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect
     }}
 }}
 
-int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
+{decode_head}
 {{
     uint8_t count, k;{extras_decl}
     uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
@@ -1265,27 +1524,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
         return {P}_E_ARG;
     }}
     count = {p}__count(dir);{"" if both else no_layouts}
-    k = 0u;
-    if (!{P}__SINGLE && count != 1u) {{
-        int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {{
-            size_t hl;
-            const uint8_t *h = {p}__header(dir, k, &hl);
-            if (hl <= len && {p}__same(frame, h, hl)) {{
-                headed = 1;
-                if ({admits}) {{
-                    break;
-                }}
-            }}
-        }}
-        if (k == count) {{
-            return headed ? {P}_E_LENGTH : {P}_E_FRAME;
-        }}
-    }}
-    r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
-    if (r != {P}_OK) {{
-        return r;
-    }}{find_extras}{refused_call}
+{taking}{find_extras}{refused_call}
     r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values,
                             {xarg}out);
     if (r != {P}_OK) {{
@@ -1294,7 +1533,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     return r;
 }}
 
-int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out)
+{decode_tail}int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out)
 {{
     return {p}_decode_expect(frame, len, dir, {P}_KIND_NONE, out);
 }}
@@ -1308,7 +1547,7 @@ typedef int (*{p}__enc_t)(const void *m, uint8_t *c, size_t cap, size_t *n);
 /* The frame of a content: the direction's layouts tried in order (a content too long for one layout's length
  * element takes the next), the content encoded in place. */
 static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values, {xparams}const void *m,
-                      {p}__enc_t enc, uint8_t *buf, size_t cap, size_t *len)
+                      {p}__enc_t enc, uint8_t *buf, size_t cap, size_t *len{pre_param})
 {{
     uint8_t count, k, i;
     const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
@@ -1338,7 +1577,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         }}
         r = enc(m, dst, room, &clen);
         if (r == {P}_OK) {{
-            r = {p}__wrap(L, buf, cap, span, clen, code, values, {"extras" if opt else "NULL"}, len);
+            r = {p}__wrap(L, buf, cap, span, clen, code, values, {"extras" if opt else "NULL"}, len{pre_arg});
         }}
         if (r == {P}_OK) {{
             return r;
@@ -1364,12 +1603,15 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
         return {P}_E_ARG;
     }}
 }}
-#endif
+{asking.functions(ctx)[1] if asks else ""}#endif
 
 """
     classic = protocol.framing.classic
     decode_rx = f"{p}_decode" if classic else f"{p}_decode_expect"
     expect_arg = "" if classic else "p->expect, "
+    if asks:  # the request's bytes the parser keeps (p_parser_expect_reply)
+        decode_rx = f"{p}__decode_with"
+        expect_arg = "p->expect, p->has_request ? p->request : NULL, p->request_len, "
     parser_common = parser_api.frame_function(p)
     parser_push = parser_api.push_function(
         p,
@@ -1377,6 +1619,12 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
         "parser->frame = parser->unknown_frame;\n        parser->frame_len = parser->unknown_len;",
     )
     expect_function = parser_api.expect_function(p, P, classic)
+    if asks:  # p_parser_expect awaits a reply without its request (Python's expect(cls): request None)
+        expect_function = expect_function.replace(
+            "    parser->expect = reply;\n", "    parser->expect = reply;\n    parser->has_request = 0u;\n"
+        )
+        assert "has_request" in expect_function
+        expect_function += asking.expect_reply(ctx)
     parsing = f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
 
@@ -1404,7 +1652,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
         return p->verdict[pos];
     }}
     for (k = 0u; k < count; k++) {{
-        long s = {p}__probe_at({P}__RX(p->dir), k, p->buf + pos, p->n - pos);
+        long s = {p}__probe_at({P}__RX(p->dir), k, p->buf + pos, p->n - pos{want_arg});
         if (s == {P}__WAIT) {{
             need = 0u;
             continue;
@@ -1619,7 +1867,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     if (h == NULL || len < hl || !{p}__same(data, h, hl)) {{
         return 0u;
     }}
-    s = {p}__probe_at({P}__RX(p->dir), 0u, data, len);
+    s = {p}__probe_at({P}__RX(p->dir), 0u, data, len{want_arg});
     if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME || (size_t)s > len) {{
         return 0u;
     }}
@@ -1767,14 +2015,21 @@ def switch_cases(cases: list[str], closed: bool, otherwise: str) -> str:
 def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:
     """A direction's messages by the command code their frames carry (None: the layout carries none; ERROR_CODE:
     the error reply)."""
-    layout = protocol.framing.layouts[direction]
     found: dict[int | None, list[Message]] = {}
     for m in messages(protocol):
         if m.direction == direction:
             wire = protocol.command(m.command).wire_code(direction)
-            code = ERROR_CODE if m.error_reply else wire if layout.has_command else None
+            code = ERROR_CODE if m.error_reply else wire if protocol.layout(m).has_command else None
             found.setdefault(code, []).append(m)
     return found
+
+
+def probe_keys(ctx: Ctx, direction: Direction) -> list[tuple[str, list[Message]]]:
+    """A direction's messages by the key the parser sizes their frames by: the code (code_key), or, where the frames
+    carry none and each is read in the layout of the reply awaited, the reply's kind (each message alone)."""
+    if asking.by_reply(ctx.protocol, direction):
+        return [(kind_name(ctx, m), [m]) for m in messages(ctx.protocol) if m.direction == direction]
+    return [(code_key(ctx.P, code), users) for code, users in messages_by_code(ctx.protocol, direction).items()]
 
 
 def code_key(P: str, code: int | None) -> str:
@@ -1784,12 +2039,21 @@ def code_key(P: str, code: int | None) -> str:
 def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
     """The content size of each code whose one message is sized by its own leading fields (model.size_terms)."""
     rows = []
-    for code, users in messages_by_code(ctx.protocol, direction).items():
+    for key, users in probe_keys(ctx, direction):
         found = size_terms(users[0].fields) if len(users) == 1 else None
+        text = nul_ended(users[0].fields) if len(users) == 1 and found is None else None
+        if text is not None:  # a NUL-terminated text ends the content: sized by its NUL (runtime SizeRule.nul)
+            rows.append(
+                f"        case {key}: {{\n            size_t i;\n"
+                f"            for (i = {text}u; i < avail; i++) {{\n"
+                f"                if (c[i] == 0u) {{\n                    return (long)(i + 1u);\n                }}\n"
+                f"            }}\n            return {ctx.P}__WAIT;\n        }}"
+            )
+            continue
         if found is None:
             continue
         fixed, terms = found
-        body = [f"        case {code_key(ctx.P, code)}:", f"            size = {fixed}L;"]
+        body = [f"        case {key}:", f"            size = {fixed}L;"]
         for offset, size, endian, factor in terms:
             big = 1 if endian == "big" else 0
             body.append(f"            if (avail < {offset + size}u) {{ return {ctx.P}__WAIT; }}")

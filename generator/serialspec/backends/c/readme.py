@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from serialspec import __version__
 from serialspec.backends.c import length_byte
+from serialspec.backends.c import requests as asking
 from serialspec.backends.c.emit import Ctx, Member, msg_id, spec_hash
 from serialspec.backends.c.files import directions, kind_name, max_frame
 from serialspec.backends.c.optional import elements_of
@@ -134,6 +135,15 @@ def readme(ctx: Ctx) -> str:
         "snprintf-like |",
         f"| `{p}_kind_name(kind)`, `{p}_result_name(result)` | names |",
     ]
+    if asking.asks(protocol):  # replies read with their request (RoboClaw)
+        out += [
+            f"| `{p}_decode_reply(frame, len, &request, &msg)` | a reply to `request` (the message sent): read in the "
+            "layout of the reply its command awaits, its checksum over the request's bytes checked |",
+            f"| `{p}_encode_reply(&msg, &request, buf, cap, &len)` | a reply to `request` as a frame (`{p}_encode` "
+            f"refuses a reply whose checksum takes in its request's bytes: `{P}_E_ARG`) |",
+            f"| `{p}_parser_expect_reply(&parser, &request)` | the parser awaits the reply to `request` (replies carry "
+            "no code: none is taken while none is awaited) |",
+        ]
     for checksum, c in ctx.checks:
         out.append(
             f"| `{c.name}(acc, data, n)` | the {checksum.name} element's checksum, usable alone: start from "

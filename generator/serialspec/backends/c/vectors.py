@@ -8,6 +8,7 @@ program runs in our tests under every compiler of the matrix.
 
 from __future__ import annotations
 
+from serialspec.backends.c import requests as asking
 from serialspec.backends.c.emit import Ctx, msg_id
 from serialspec.backends.c.files import banner
 from serialspec.lang.model import Direction, Message, Protocol
@@ -50,21 +51,47 @@ def vectors(ctx: Ctx) -> tuple[list[tuple[str, Direction, str, bytes]], list[tup
     return good, refused
 
 
+def request_frame(protocol: Protocol, name: str) -> bytes | None:
+    """The frame of the request an example answers (its `request:` example, else the first example of its command's
+    request), where replies are read with their request; None otherwise."""
+    example = next(e for e in protocol.examples if e.name == name)
+    if example.direction != Direction.RESPONSE or not asking.asks(protocol):
+        return None
+    if example.request:
+        return next(e.frame for e in protocol.examples if e.name == example.request)
+    return next(
+        (
+            e.frame
+            for e in protocol.examples
+            if (e.command, e.subcommand, e.direction) == (example.command, example.subcommand, Direction.REQUEST)
+        ),
+        None,
+    )
+
+
 def vectors_header(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
     good, refused = vectors(ctx)
+    asks = asking.asks(protocol)
     arrays: list[str] = []
     rows: list[str] = []
     for i, (name, direction, kind, frame) in enumerate(good):
         arrays.append(f"static const uint8_t {p}__vector_{i}[] = {{\n    {_bytes(frame)}\n}};")
-        rows.append(f"    {{{_c_string(name)}, {P}_{direction.name}, {kind}, {p}__vector_{i}, {len(frame)}u}},")
+        asked = ""
+        if asks:  # the request a reply answers (decoded, then given to p_decode_reply): its frame
+            request = request_frame(protocol, name)
+            if request is not None:
+                arrays.append(f"static const uint8_t {p}__request_{i}[] = {{\n    {_bytes(request)}\n}};")
+            asked = f", {p}__request_{i}, {len(request)}u" if request is not None else ", NULL, 0u"
+        rows.append(f"    {{{_c_string(name)}, {P}_{direction.name}, {kind}, {p}__vector_{i}, {len(frame)}u{asked}}},")
+    none = ", NULL, 0u" if asks else ""
     refused_rows: list[str] = []
     for i, (name, direction, frame) in enumerate(refused):
         arrays.append(f"static const uint8_t {p}__refused_{i}[] = {{\n    {_bytes(frame)}\n}};")
         refused_rows.append(
-            f"    {{{_c_string(name)}, {P}_{direction.name}, {P}_KIND_NONE, {p}__refused_{i}, {len(frame)}u}},"
+            f"    {{{_c_string(name)}, {P}_{direction.name}, {P}_KIND_NONE, {p}__refused_{i}, {len(frame)}u{none}}},"
         )
-    end = f"    {{NULL, {P}_REQUEST, {P}_KIND_NONE, NULL, 0u}} /* end */"
+    end = f"    {{NULL, {P}_REQUEST, {P}_KIND_NONE, NULL, 0u{none}}} /* end */"
     return (
         banner(protocol)
         + f"/* Golden vectors of {protocol.title}: every example frame the spec records (a frame, its direction and\n"
@@ -78,7 +105,15 @@ def vectors_header(ctx: Ctx) -> str:
         f"    {p}_kind_t kind;        /* the message it decodes to ({P}_KIND_NONE: refused) */\n"
         "    const uint8_t *frame;\n"
         "    size_t len;\n"
-        f"}} {p}_vector_t;\n\n" + "".join(a + "\n\n" for a in arrays) + f"#define {P}_VECTOR_COUNT {len(good)}u\n"
+        + (
+            "    const uint8_t *request; /* a reply's: the frame of the request it answers (NULL: none) */\n"
+            "    size_t request_len;\n"
+            if asks
+            else ""
+        )
+        + f"}} {p}_vector_t;\n\n"
+        + "".join(a + "\n\n" for a in arrays)
+        + f"#define {P}_VECTOR_COUNT {len(good)}u\n"
         f"static const {p}_vector_t {p}_vectors[] = {{\n" + "".join(r + "\n" for r in rows) + end + "\n};\n\n"
         f"#define {P}_REFUSED_COUNT {len(refused)}u\n"
         f"static const {p}_vector_t {p}_refused[] = {{\n"
@@ -91,6 +126,38 @@ def vectors_header(ctx: Ctx) -> str:
 
 def check_vectors(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    decode = f"        int result = {p}_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);\n"
+    encode = f"            result = {p}_encode(&msg, buf, sizeof buf, &len);\n"
+    expect = ""
+    asked = ""
+    if asking.asks(protocol):  # a reply read with its request: the request decoded from its frame, then given
+        asked = (
+            f"        {p}_msg_t req;\n"
+            "        int asked = 0;\n"
+            f"#if {P}_ENABLE_DECODE\n"
+            "        if (v->request != NULL) {\n"
+            f"            if (!{P}_DECODES_REQUESTS) {{\n"
+            "                continue; /* a build that decodes no request cannot make it from its frame */\n"
+            "            }\n"
+            f"            asked = {p}_decode(v->request, v->request_len, {P}_REQUEST, &req) == {P}_OK;\n"
+            "            if (!asked) {\n"
+            f'                {p}__fail(&failed, v->name, "its request does not decode", {P}_OK);\n'
+            "                continue;\n"
+            "            }\n"
+            "        }\n"
+            "#endif\n"
+            "        (void)req;\n"
+            "        (void)asked;\n"
+        )
+        decode = (
+            f"        int result = asked ? {p}_decode_reply(v->frame, v->len, &req, &msg)\n"
+            f"                           : {p}_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);\n"
+        )
+        encode = (
+            f"            result = asked ? {p}_encode_reply(&msg, &req, buf, sizeof buf, &len)\n"
+            f"                           : {p}_encode(&msg, buf, sizeof buf, &len);\n"
+        )
+        expect = f"            if (asked)\n                {p}_parser_expect_reply(&parser, &req);\n"
     return (
         banner(protocol)
         + f"/* Checks the generated {protocol.title} C against the spec's golden vectors: build it with\n"
@@ -112,9 +179,10 @@ def check_vectors(ctx: Ctx) -> str:
         "        /* what the build keeps of this direction (its role: the other side's is refused) */\n"
         f"        const int decodes = v->direction == {P}_REQUEST ? {P}_DECODES_REQUESTS : {P}_DECODES_RESPONSES;\n"
         f"        const int encodes = v->direction == {P}_REQUEST ? {P}_ENCODES_REQUESTS : {P}_ENCODES_RESPONSES;\n"
-        f"#if {P}_ENABLE_DECODE\n"
-        f"        int result = {p}_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);\n"
-        f"        if (!decodes && result != {P}_E_ARG) {{\n"
+        + asked
+        + f"#if {P}_ENABLE_DECODE\n"
+        + decode
+        + f"        if (!decodes && result != {P}_E_ARG) {{\n"
         f'            {p}__fail(&failed, v->name, "the other side\'s frame is not refused", result);\n'
         "            continue;\n"
         "        }\n"
@@ -126,8 +194,8 @@ def check_vectors(ctx: Ctx) -> str:
         "        if (decodes && encodes) {\n"
         f"            uint8_t buf[{P}_MAX_FRAME];\n"
         "            size_t len = 0;\n"
-        f"            result = {p}_encode(&msg, buf, sizeof buf, &len);\n"
-        f"            if (result != {P}_OK || len != v->len || memcmp(buf, v->frame, len) != 0)\n"
+        + encode
+        + f"            if (result != {P}_OK || len != v->len || memcmp(buf, v->frame, len) != 0)\n"
         f'                {p}__fail(&failed, v->name, "encode gives other bytes", result);\n'
         "        }\n"
         "#endif\n"
@@ -138,7 +206,8 @@ def check_vectors(ctx: Ctx) -> str:
         "            size_t at = 0;\n"
         "            bool got = false;\n"
         f"            {p}_parser_init(&parser, v->direction);\n"
-        "            while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */\n"
+        + expect
+        + "            while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */\n"
         f"                at += {p}_parser_feed(&parser, v->frame + at, 1, &msg, &got);\n"
         "            if (!got || at != v->len)\n"
         f'                {p}__fail(&failed, v->name, "the parser does not find the frame", {P}_OK);\n'

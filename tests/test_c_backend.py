@@ -664,6 +664,17 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
 
 
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_a_tail_that_begins_a_header_is_held_as_python_holds_it(g: Generated) -> None:
+    """Garbage, then a header's first bytes (`00 ff` before DYNAMIXEL's ff ff fd): the bytes held and the garbage
+    counted are Python's (C held every byte a header could still fill; Python holds from where a header begins)."""
+    for direction, layout in g.protocol.framing.layouts.items():
+        header = layout.header or b""
+        for k in range(1, len(header)):
+            for garbage in (b"\x00", b"\x01\x00\x02", header[k : k + 1] or b"\x00"):
+                stream_agrees_with_python(driver(g.protocol.name), g, direction, garbage + header[:k], "1")
+
+
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
 def test_the_parser_without_its_whole_frame_path_gives_what_python_gives(g: Generated, tmp_path: Path) -> None:
     """P_PARSER_WHOLE_FRAMES=0 (every byte through push, for the smallest flash) and, for frames of the length-byte
     shape, P_PARSER_SMALL=1 (the smallest parser; the default push is held to Python by the other stream tests): noisy

@@ -2113,6 +2113,28 @@ static int dynamixel_p2__ends_header(const dynamixel_p2_parser_t *p)
 }
 #endif
 
+/* The bytes held after a scan that took nothing and holds no candidate: from the first position whose bytes (fewer
+ * than a header's) begin a header, a candidate waiting as the Python parser holds it; else from `from`, the tail that
+ * could begin one. */
+static size_t dynamixel_p2__tail(const dynamixel_p2_parser_t *p, size_t from)
+{
+#if DYNAMIXEL_P2__HEADERS
+    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
+    size_t pos, hl;
+    for (pos = from; pos < p->n; pos++) {
+        for (k = 0u; k < count; k++) {
+            const uint8_t *h = dynamixel_p2__header(DYNAMIXEL_P2__RX(p->dir), k, &hl);
+            if (hl > p->n - pos && dynamixel_p2__same(p->buf + pos, h, p->n - pos)) {
+                return pos;
+            }
+        }
+    }
+#else
+    (void)p;
+#endif
+    return from;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
  * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
  * the scan decides could change before then. */
@@ -2187,6 +2209,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
         if (cut < done) {
             cut = done;
         }
+        cut = dynamixel_p2__tail(p, cut);
     } else {
         cut = got ? done : p->n;
     }

@@ -2676,6 +2676,28 @@ static int modbus_rtu__ends_header(const modbus_rtu_parser_t *p)
 }
 #endif
 
+/* The bytes held after a scan that took nothing and holds no candidate: from the first position whose bytes (fewer
+ * than a header's) begin a header, a candidate waiting as the Python parser holds it; else from `from`, the tail that
+ * could begin one. */
+static size_t modbus_rtu__tail(const modbus_rtu_parser_t *p, size_t from)
+{
+#if MODBUS_RTU__HEADERS
+    uint8_t count = modbus_rtu__count(MODBUS_RTU__RX(p->dir)), k;
+    size_t pos, hl;
+    for (pos = from; pos < p->n; pos++) {
+        for (k = 0u; k < count; k++) {
+            const uint8_t *h = modbus_rtu__header(MODBUS_RTU__RX(p->dir), k, &hl);
+            if (hl > p->n - pos && modbus_rtu__same(p->buf + pos, h, p->n - pos)) {
+                return pos;
+            }
+        }
+    }
+#else
+    (void)p;
+#endif
+    return from;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
  * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
  * the scan decides could change before then. */
@@ -2750,6 +2772,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
         if (cut < done) {
             cut = done;
         }
+        cut = modbus_rtu__tail(p, cut);
     } else {
         cut = got ? done : p->n;
     }

@@ -4281,6 +4281,28 @@ static int roboclaw__ends_header(const roboclaw_parser_t *p)
 }
 #endif
 
+/* The bytes held after a scan that took nothing and holds no candidate: from the first position whose bytes (fewer
+ * than a header's) begin a header, a candidate waiting as the Python parser holds it; else from `from`, the tail that
+ * could begin one. */
+static size_t roboclaw__tail(const roboclaw_parser_t *p, size_t from)
+{
+#if ROBOCLAW__HEADERS
+    uint8_t count = roboclaw__count(ROBOCLAW__RX(p->dir)), k;
+    size_t pos, hl;
+    for (pos = from; pos < p->n; pos++) {
+        for (k = 0u; k < count; k++) {
+            const uint8_t *h = roboclaw__header(ROBOCLAW__RX(p->dir), k, &hl);
+            if (hl > p->n - pos && roboclaw__same(p->buf + pos, h, p->n - pos)) {
+                return pos;
+            }
+        }
+    }
+#else
+    (void)p;
+#endif
+    return from;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
  * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
  * the scan decides could change before then. */
@@ -4355,6 +4377,7 @@ static int roboclaw__push(roboclaw_parser_t *p, uint8_t byte, roboclaw_msg_t *ou
         if (cut < done) {
             cut = done;
         }
+        cut = roboclaw__tail(p, cut);
     } else {
         cut = got ? done : p->n;
     }

@@ -2383,6 +2383,28 @@ static int ubx__ends_header(const ubx_parser_t *p)
 }
 #endif
 
+/* The bytes held after a scan that took nothing and holds no candidate: from the first position whose bytes (fewer
+ * than a header's) begin a header, a candidate waiting as the Python parser holds it; else from `from`, the tail that
+ * could begin one. */
+static size_t ubx__tail(const ubx_parser_t *p, size_t from)
+{
+#if UBX__HEADERS
+    uint8_t count = ubx__count(UBX__RX(p->dir)), k;
+    size_t pos, hl;
+    for (pos = from; pos < p->n; pos++) {
+        for (k = 0u; k < count; k++) {
+            const uint8_t *h = ubx__header(UBX__RX(p->dir), k, &hl);
+            if (hl > p->n - pos && ubx__same(p->buf + pos, h, p->n - pos)) {
+                return pos;
+            }
+        }
+    }
+#else
+    (void)p;
+#endif
+    return from;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
  * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
  * the scan decides could change before then. */
@@ -2457,6 +2479,7 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
         if (cut < done) {
             cut = done;
         }
+        cut = ubx__tail(p, cut);
     } else {
         cut = got ? done : p->n;
     }

@@ -61,14 +61,14 @@ def spec(tmp_path: Path, extra: str = "") -> Path:
     return path
 
 
-def decode_json(path: Path, line: str) -> dict[str, object]:
-    out = subprocess.run(
-        [sys.executable, "-m", "serialspec", "decode", str(path), line, "--json"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-    return json.loads(out)  # type: ignore[no-any-return]
+def decode_json(path: Path, line: str) -> dict[str, Any]:
+    """`serialspec decode PATH LINE --json`, in this process (the CLI's processes are tests/test_cli.py's)."""
+    from serialspec import cli
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["decode", str(path), line, "--json"]) == 0
+    return json.loads(out.getvalue())  # type: ignore[no-any-return]
 
 
 def test_ok_and_error_lines_decode(tmp_path: Path) -> None:
@@ -231,12 +231,7 @@ def test_the_state_word_with_a_sub_state(tmp_path: Path) -> None:
     extra = "".join(SUB_STATE.format(word=word.lower(), code=word) for word in ("Hold", "Door"))
     path = spec(tmp_path, extra)
     load_protocol(str(path), "grbl")
-    from serialspec import cli
-
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        assert cli.main(["decode", str(path), "--json", "<Hold:1|MPos:1.000,2.000,3.000|Ln:4>"]) == 0
-    report = json.loads(out.getvalue())
+    report = decode_json(path, "<Hold:1|MPos:1.000,2.000,3.000|Ln:4>")
     assert report["command"] == "status_hold" and report["fields"]["sub_state"] == "1"  # type: ignore[index]
     for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
         del sys.modules[name]

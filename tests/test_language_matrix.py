@@ -631,6 +631,45 @@ CASES["frame: error header (error_value), an error reply without fields"] = Case
     },
     {"refused": {"response": {"error_reply": True, "fields": {}}}},
 )
+# MSP v1 beside v2: layouts told apart by header with different element orders and checksums, and a code only
+# the second layout's u16 command element holds (encode sends it there; a code both hold goes in the first)
+CASES["frame: layouts, a code only a later layout's command element holds"] = Case(
+    {"v": "u8"},
+    {"v": "u16"},
+    {
+        "layouts": {
+            "v1": {
+                "elements": {
+                    "header": {"role": "header", "value": {"request": "24 4d 3c", "response": "24 4d 3e"}},
+                    "size": {"role": "length", "type": "u8"},
+                    "code": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["size", "content"]},
+                }
+            },
+            "v2": {
+                "elements": {
+                    "header": {"role": "header", "value": {"request": "24 58 3c", "response": "24 58 3e"}},
+                    "flag": {"role": "constant", "value": "00"},
+                    "code": {"role": "command", "type": "u16"},
+                    "size": {"role": "length", "type": "u16"},
+                    "content": {"role": "content"},
+                    "checksum": {
+                        "role": "checksum",
+                        "type": "u8",
+                        "algorithm": "crc",
+                        "crc": DVB_S2,
+                        "covers": ["flag", "content"],
+                    },
+                }
+            },
+        }
+    },
+    {"wide": {"code": 0x2002, "request": {"fields": {"w": "u16"}}, "response": {"fields": {"x": "i32"}}}},
+)
+C_REFUSES["frame: layouts, a code only a later layout's command element holds"] = (
+    "a command element that holds only some codes (layout v1)"
+)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},
@@ -1504,7 +1543,8 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
 
 
 def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
-    """`text:` (a message's own start, end, separator, labels and lists) beside the case's plain sentences: C and
+    """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value
+    right after the code) beside the case's plain sentences: C and
     Wireshark refuse it in one line; the markdown page shows the labels; the generated package round-trips random
     messages (labels left out where a value is None) and finds them byte by byte among garbage and other sentences;
     the simulator sends it."""
@@ -1520,6 +1560,11 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
             "unsolicited": True,
             "text": {"start": "<", "end": ">", "separator": "|", "named": "=", "list": ","},
             "fields": {
+                "sub": {
+                    "label": "RP",
+                    "type": "integer",
+                    "range": [0, 9],
+                },  # after the code: `<RP=3|…>` (GRBL's Hold:0)
                 "lvl": {"label": "LV", "type": "integer", "range": [0, 99]},
                 "pos": {
                     "label": "P",
@@ -1544,6 +1589,7 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
         assert emitter.verify is None or emitter.verify(protocol, emitted) == []
         files.update(emitted)
     docs = files["docs/matrix_text.md"]
+    assert "| `RP=`, right after the code | `sub` |" in docs
     assert "| `LV=` | `lvl` |" in docs and "`sats[].n`" in docs and "Its own text inside the frame: `<`" in docs
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -1557,6 +1603,8 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
             assert frame.startswith(b"#<BRP") and package.decode(frame, "response") == message
             frames += b"\x00garbage#\n" + frame + other
             messages += [message, package.AnswerResponse(talker="A", ok=package.Side.NORTH)]
+            sub = package.encode(package.ReportResponse.from_fields({**values, "sub": 3}, talker="B"))
+            assert sub.startswith(b"#<BRP=3") and b"RP=" not in sub[7:]  # right after the code, once
         parser = package.StreamParser("response")
         assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
         device = importlib.import_module("matrix_text.simulator").SIMULATOR()

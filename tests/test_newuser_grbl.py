@@ -1,7 +1,8 @@
 """GRBL 1.1 (a CNC controller's text protocol: `ok`, `error:N`, `ALARM:N`, `<Idle|MPos:0.000,0.000,0.000|FS:0,0>`),
 tried from the user docs alone. There is no PyPI peer worth the name, so there is no spec under tests/specs: what the
-text language takes (`ok`, `error:20`, the status report in its own text layout) works, and each thing it cannot take
-is a strict xfail naming the gap. examples/grbl/grbl.yaml is the tutorial's spec of the status report."""
+text language takes (`ok`, `error:20`, the status report in its own text layout, a state with its sub-state) works,
+and each thing it cannot take is a strict xfail naming the gap. examples/grbl/grbl.yaml is the tutorial's spec of
+the status report."""
 
 from __future__ import annotations
 
@@ -60,14 +61,14 @@ def spec(tmp_path: Path, extra: str = "") -> Path:
     return path
 
 
-def decode_json(path: Path, line: str) -> dict[str, object]:
-    out = subprocess.run(
-        [sys.executable, "-m", "serialspec", "decode", str(path), line, "--json"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-    return json.loads(out)  # type: ignore[no-any-return]
+def decode_json(path: Path, line: str) -> dict[str, Any]:
+    """`serialspec decode PATH LINE --json`, in this process (the CLI's processes are tests/test_cli.py's)."""
+    from serialspec import cli
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["decode", str(path), line, "--json"]) == 0
+    return json.loads(out.getvalue())  # type: ignore[no-any-return]
 
 
 def test_ok_and_error_lines_decode(tmp_path: Path) -> None:
@@ -216,17 +217,46 @@ def test_a_command_per_state_word(tmp_path: Path) -> None:
     assert {r["fields"]["line"] for r in reports} == {"4"}
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: the state word with a sub-state (`<Hold:0|...>`, `<Door:1|...>`) cannot be a text code "
-    "(`:` is refused in a code, and the own layout's `named` splits it), and no field of the report can stand in the "
-    "code's place (an enum of the state words): a message's own text layout chooses its message by the word after "
-    "its start, so the state is one command per word, without sub-states",
+# the same report with the sub-state after the state word: the field labelled with the code
+SUB_STATE = STATES.replace(
+    "      fields:\n", "      fields:\n        sub_state: {{label: {code}, type: integer, range: [0, 9]}}\n"
 )
+
+
 def test_the_state_word_with_a_sub_state(tmp_path: Path) -> None:
-    extra = STATES.format(word="hold", code='"Hold:0"')
+    """`<Hold:0|…>`, `<Door:1|…>`: the field labelled with the code is the value right after it; `<Hold|…>` leaves
+    it None, and encode writes it after the code (none where it is None)."""
+    from conftest import generate_and_import
+
+    extra = "".join(SUB_STATE.format(word=word.lower(), code=word) for word in ("Hold", "Door"))
     path = spec(tmp_path, extra)
     load_protocol(str(path), "grbl")
+    report = decode_json(path, "<Hold:1|MPos:1.000,2.000,3.000|Ln:4>")
+    assert report["command"] == "status_hold" and report["fields"]["sub_state"] == "1"  # type: ignore[index]
+    for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
+        del sys.modules[name]
+    grbl = generate_and_import(path, tmp_path / "out", "grbl")
+    for name in [m for m in sys.modules if m.partition(".")[0] == "grbl"]:
+        del sys.modules[name]
+    door = grbl.decode(b"<Door:3|Ln:7>\r\n")
+    assert isinstance(door, grbl.StatusDoorResponse) and (door.sub_state, door.line) == (3, 7)
+    assert grbl.encode(door) == b"<Door:3|Ln:7>\r\n"
+    bare = grbl.decode(b"<Hold|MPos:1.000,2.000,3.000>\r\n")
+    assert bare.sub_state is None and grbl.encode(bare) == b"<Hold|MPos:1.000,2.000,3.000>\r\n"
+    stream = b"ok\r\n<Hold:0|Ln:1>\r\n<Door:1>\r\n"
+    parser = grbl.StreamParser()
+    found = [m for byte in stream for m in parser.feed(bytes([byte]))]
+    assert [(type(m).__name__, getattr(m, "sub_state", None)) for m in found] == [
+        ("OkResponse", None),
+        ("StatusHoldResponse", 0),
+        ("StatusDoorResponse", 1),
+    ]
+    for bad, reason in (
+        ("<Hold:x|Ln:1>", "Hold: sub_state = 'x' is not an integer"),
+        ("<Hold:0|Hold:1>", "Hold: label 'Hold' sent twice"),
+    ):
+        with pytest.raises(DecodeError, match=f"^{reason}"):
+            grbl.decode(bad)
 
 
 def test_the_status_report_s_package(example: ModuleType) -> None:

@@ -2,7 +2,8 @@
 (Betaflight's and iNAV's Python MSP client): our codec reads the requests its send_RAW_msg builds and re-encodes
 them byte for byte, and yamspy connects to `serialspec sim` on a real pseudo-terminal (its API_VERSION and
 FC_VARIANT handshake) and reads the attitude and altitude it answers. MSP v2 ($X<, u16 command, u16 size, CRC-8
-DVB-S2) beside v1 is the strict xfail below."""
+DVB-S2) beside v1 in one spec: two layouts told apart by header, a v2-only code (above 255) sent in v2 as yamspy
+sends it."""
 
 from __future__ import annotations
 
@@ -185,3 +186,36 @@ def test_an_unknown_command_gets_the_error_header(msp: ModuleType) -> None:
     with serve(str(SPEC)) as path, serial.Serial(path, 115200, timeout=2) as port:
         port.write(peer_request(yamspy.MSPy.MSPCodes["MSP_RC"]))
         assert port.read(6) == b"$M!\x00\x69\x69"
+
+
+V2_COMMAND = """  inav_analog:
+    code: 0x2002
+    title: Battery and RSSI (MSPV2_INAV_ANALOG)
+    request: {fields: {}}
+    response: {fields: {battery_flags: u8, voltage: u16, amperage: u16}}
+"""
+
+
+def test_v2_codes_travel_in_v2_beside_v1(tmp_path: Path) -> None:
+    """v1 and v2 in one spec: a code above 255 does not fit v1's u8 command element, so it is sent in v2 (as
+    yamspy's send_RAW_msg sends it), a code both hold in v1, the first layout; a frame is read by its header, and
+    the stream parser takes both forms back to back."""
+    spec = spec_with_v2(tmp_path)
+    text = spec.read_text("utf-8")
+    text = text.replace("  refused:\n", V2_COMMAND + "  refused:\n").replace("protocol: msp\n", "protocol: msp_mixed\n")
+    spec.write_text(text, "utf-8")
+    mixed = generate_and_import(spec, tmp_path / "out", "msp_mixed")
+    for message, code in [
+        (mixed.InavAnalogRequest(), yamspy.MSPy.MSPCodes["MSPV2_INAV_ANALOG"]),
+        (mixed.AttitudeRequest(), yamspy.MSPy.MSPCodes["MSP_ATTITUDE"]),
+    ]:
+        golden = peer_request(code)
+        assert mixed.encode(message) == golden
+        assert mixed.decode(golden, mixed.Direction.REQUEST) == message
+    reply = mixed.InavAnalogResponse(battery_flags=0x41, voltage=1680, amperage=250)
+    frame = mixed.encode(reply)
+    assert frame[:3] == b"$X>" and frame[4:6] == (0x2002).to_bytes(2, "little")
+    attitude = mixed.AttitudeResponse(roll=1, pitch=-2, yaw=3)
+    stream = mixed.encode(attitude) + frame + mixed.encode(attitude)
+    parser = mixed.StreamParser()
+    assert [m for byte in stream for m in parser.feed(bytes([byte]))] == [attitude, reply, attitude]

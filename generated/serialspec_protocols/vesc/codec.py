@@ -492,7 +492,7 @@ _REQUEST_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object,
 
 
 def _wrap_request(content: bytes, code: int | None) -> bytes:
-    """The request frame around `content`, in the first layout whose length can count it."""
+    """The request frame around `content`, in the first layout that holds its code and whose length can count it."""
     v_length = len(content) + 1
     if v_length < 256:
         frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
@@ -603,7 +603,7 @@ _RESPONSE_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object
 
 
 def _wrap_response(content: bytes, code: int | None) -> bytes:
-    """The response frame around `content`, in the first layout whose length can count it."""
+    """The response frame around `content`, in the first layout that holds its code and whose length can count it."""
     v_length = len(content) + 1
     if v_length < 256:
         frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content

@@ -367,7 +367,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "label": Str(
         "Text frames, in a message whose `text` has `named`: the label the field's value follows (GRBL's `MPos` in "
         "`MPos:1.000,2.000,3.000`). Labelled fields are found by their label in any order; a label absent from a "
-        "frame leaves its field None (a repeat: empty) and encode leaves out the fields that are None.",
+        "frame leaves its field None (a repeat: empty) and encode leaves out the fields that are None. A field "
+        "labelled with the message's own code is written right after the code (GRBL's sub-state: `code: Hold` and "
+        "`sub_state: {label: Hold, type: integer}` read `<Hold:0|…>`; `<Hold|…>` leaves it None).",
         example="MPos",
     ),
     "description": TEXT,
@@ -979,7 +981,10 @@ FRAMING = Obj(
                 description="One alternative layout: its elements in wire order.",
             ),
             "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
-            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length). They all have a command "
+            "whose command element holds the code and whose length can count the frame (VESC: 02 + u8 length, 03 "
+            "+ u16 length; MSP v1 `$M<`, u8 size, u8 command, XOR, beside v2 `$X<`, u16 command, u16 size, "
+            "CRC-8/DVB-S2: a code above 255 is sent in v2, any other in v1; a code must fit one layout; the C "
+            "target refuses a command element that holds only some codes). They all have a command "
             "element or none, unless each command names its layout (`layout:`). One layout may have no header if "
             "it starts with its command element: it takes every frame that starts with no other layout's header, "
             "and no code it sends may start as a header does (checked when the spec is read), so a frame is told "

@@ -129,7 +129,8 @@ class TextRepeat:
 class TextLayout:
     """A message's own text inside the frame (GRBL's status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>`):
     `start` + code + `separator`-joined fields + `end`. With `named`, each field is its label, `named` and its
-    value, found by the label in any order (an absent label: None); a repeat's values are joined by `list`."""
+    value, found by the label in any order (an absent label: None), the field labelled with the code right after
+    the code (`Hold:0`); a repeat's values are joined by `list`."""
 
     start: str
     end: str = ""
@@ -244,12 +245,14 @@ class TextFraming:
     def _decode_in(self, layout: TextLayout, inner: str, direction: str | None) -> Sentence:
         """A frame in a message's own layout (its start and end taken off)."""
         parts = inner.split(layout.separator)
-        talker, code = parts[0][: self.talker], parts[0][self.talker :]
+        talker, address = parts[0][: self.talker], parts[0][self.talker :]
+        # with labels, the code may carry a value as a label does (GRBL's `Hold:0`): the field labelled with the code
+        code, after = (address.partition(layout.named)[0], address) if layout.named else (address, "")
         sentence = self.sentence(code, direction)
         if sentence.layout != layout:
             raise DecodeError(f"{sentence.where} is not sent as {layout.start}…{layout.end}")
         if layout.named:
-            values = _decode_labelled(sentence, layout, parts[1:])
+            values = _decode_labelled(sentence, layout, [after, *parts[1:]] if after != code else parts[1:])
         else:
             values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
         return Sentence(talker, code, values, -1, sentence.direction)
@@ -370,7 +373,9 @@ def _encode_in(
         value = values.get(item.name)
         if isinstance(item, TextField):
             text = encode_field(sentence.where, item, value, forbidden)
-            if value is not None or not layout.named:
+            if layout.named and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
+                parts[0] += f"{layout.named}{text}" if value is not None else ""
+            elif value is not None or not layout.named:
                 parts.append(f"{item.label}{layout.named}{text}" if layout.named else text)
             continue
         if not value and layout.named:

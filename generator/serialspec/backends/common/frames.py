@@ -66,9 +66,12 @@ def runtime_layout(layout: FrameLayout, codes: tuple[int, ...] | None = None) ->
 
 def layout_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | None:
     """The command codes sent in a layout, where layouts are chosen by command (`layout:`) and its frames carry
-    one; None otherwise (any code)."""
-    if not protocol.framing.by_command or not layout.has_command:
+    one, or where its command element is too narrow for some codes (MSP v1's u8 beside v2's u16: those travel in
+    a layout that holds them); None otherwise (any code)."""
+    if not layout.has_command:
         return None
+    if not protocol.framing.by_command:
+        return held_codes(protocol, layout)
     codes = set()
     for command in protocol.commands:
         code = command.wire_code(layout.direction)
@@ -76,6 +79,22 @@ def layout_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | N
             if code is not None and message.direction == layout.direction and protocol.layout(message) == layout:
                 codes.add(code)
     return tuple(sorted(codes))
+
+
+def held_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | None:
+    """The codes a layout's command element holds, where it does not hold every code of its direction; None
+    where it does."""
+    element = next(e for e in layout.elements if e.role == "command")
+    if element.type is None or element.code or layout.error:  # (an error reply carries the refused request's code)
+        return None
+    codes = {
+        code
+        for command in protocol.commands
+        if (code := command.wire_code(layout.direction)) is not None
+        and any(m.direction == layout.direction for m in command.messages())
+    }
+    held = {code for code in codes if element.type.minimum <= code <= element.type.maximum}
+    return None if held == codes else tuple(sorted(held))
 
 
 def layout_index(protocol: Protocol, message: Message) -> int:
@@ -108,6 +127,8 @@ def refuse_code_forms(protocol: Protocol) -> None:
     for layout, _ in layouts:
         if any(e.code for e in layout.elements if e.role == "command"):
             raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
+        if not protocol.framing.by_command and layout.has_command and held_codes(protocol, layout) is not None:
+            raise Unsupported(f"a command element that holds only some codes (layout {layout.name})")
     for layout, alternatives in layouts:
         if alternatives > 1 and not layout.header and not protocol.framing.by_command:
             raise Unsupported(f"a layout without a header beside layouts with one (layout {layout.name})")

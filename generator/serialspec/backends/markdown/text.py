@@ -75,6 +75,8 @@ def _rows(message: TextMessage) -> Iterator[str]:
     for item in message.fields:
         # by position, or by label in a message's own text with `named`
         first = code_span(item.label + layout.named) if layout is not None and layout.named else str(index)
+        if layout is not None and layout.named and item.label == message.code:
+            first += ", right after the code"  # the code's own value (GRBL's `Hold:0`)
         if isinstance(item, TextRepeat):
             times = f"{item.count} times" if item.count else f"up to {item.max_count} times, at the end"
             first = first if item.label else f"{index}.."

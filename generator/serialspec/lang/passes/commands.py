@@ -14,6 +14,7 @@ from serialspec.lang.model import (
     Command,
     Direction,
     Field,
+    FrameElement,
     FrameLayout,
     Framing,
     Message,
@@ -479,22 +480,26 @@ class Commands(FieldResolver):
                     ("commands", command.name, "code"),
                     "its frames have no command field, so no code",
                 )
-            element = next(
-                (
-                    e
-                    for d, layout in framing.layouts.items()
-                    for e in layout.elements
-                    if e.role == "command" and d in directions
-                ),
-                None,
-            )
-            if element is not None and element.type is not None and command.code is not None:
+            # a code fits the command element of some layout it may travel in (alternatives told apart by header:
+            # encode sends it in the first that holds it, MSP v2's u16 codes beside v1's u8 ones)
+            elements = [
+                e
+                for d in directions
+                for layout in (
+                    (layouts[d],) if framing.by_command else framing.alternatives.get(d, (framing.layouts[d],))
+                )
+                for e in layout.elements
+                if e.role == "command" and e.type is not None and not layout.error
+            ]
+            code = command.code
+            if elements and code is not None and not any(fits(e, code) for e in elements):
+                element = elements[0]
+                assert element.type is not None
                 low, high = element.type.minimum, element.type.maximum
-                if not low <= command.code <= high:
-                    self.error(
-                        ("commands", command.name, "code"),
-                        f"code {command.code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
-                    )
+                self.error(
+                    ("commands", command.name, "code"),
+                    f"code {code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
+                )
         for direction, layout in framing.layouts.items():
             sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
@@ -746,3 +751,9 @@ def message_path(message: Message) -> Path:
 
 def integer_field(message: Message, name: str) -> bool:
     return any(isinstance(f, Scalar) and not f.type.is_float and f.name == name for f in message.fields)
+
+
+def fits(element: FrameElement, code: int) -> bool:
+    """The command element holds the code (one with a `code` expression: its wire code is checked by layout)."""
+    assert element.type is not None
+    return bool(element.code) or element.type.minimum <= code <= element.type.maximum

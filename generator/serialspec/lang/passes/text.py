@@ -240,6 +240,8 @@ class TextPass(Pass):
                 self.error(where, "a repeat in a message's own text needs `text.list` between its values")
             if isinstance(item, TextRepeat) and any(f.label for f in item.fields):
                 self.error(where, "a label goes on the repeat, not on its fields")
+            if isinstance(item, TextRepeat) and item.label == code:
+                self.error((*where, "label"), "the field after the code (labelled with the code) is one value")
         labels = [item.label for item in fields if item.label]
         if len(set(labels)) != len(labels):
             self.error((*path[:-1], "fields"), "two fields share a label")

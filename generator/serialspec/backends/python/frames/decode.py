@@ -355,6 +355,8 @@ def whole_frames(
     positions = Positions(layout)
     entries: list[tuple[bytes, str, str]] = []
     for code, size, cls, content, fmt in plain:
+        if layout.codes is not None and code not in layout.codes:
+            continue  # sent in another layout
         head = b""
         for element in elements[: layout.content]:
             if element.kind == "constant":

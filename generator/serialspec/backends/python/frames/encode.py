@@ -166,6 +166,8 @@ def wrap_parts(
             prelude.append(f"wire = {transparency}.encode(plain)")
         wire = "wire"
     fits: list[tuple[str, str]] = []
+    if layout.codes is not None:  # its command element holds some codes: the others travel in a later layout
+        fits.append((f"code in {set(layout.codes)!r}", 'raise EncodeError(f"no layout sends code {code}")'))
     for element in elements:
         if element.kind != "length":
             continue
@@ -225,7 +227,11 @@ def wrap_lines(direction: str, layouts: list[LayoutEncoding], target: Target) ->
     """`def _wrap_<direction>(content, code, *values) -> bytes`: the frame in the first layout whose lengths can
     count it (as FrameCodec.wrap chooses), each layout's code inline."""
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
-    doc = "in the first layout whose length can count it" if len(layouts) > 1 else "EncodeError if it cannot be"
+    doc = (
+        "in the first layout that holds its code and whose length can count it"
+        if len(layouts) > 1
+        else "EncodeError if it cannot be"
+    )
     body: Lines = []
     for number, wrap in enumerate(layouts):
         body += wrap.prelude
@@ -426,7 +432,12 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
         frames = package.straight(message.direction)
         refusing = error is not None and not error.flag  # under the error header: its layouts alone
         if frames:
-            kept = [i for i, layout in enumerate(frames.layouts) if layout.error == refusing]
+            kept = [
+                i
+                for i, layout in enumerate(frames.layouts)
+                if layout.error == refusing
+                and (refusing or layout.codes is None or command_code is None or command_code in layout.codes)
+            ]
             frames = replace(
                 frames,
                 layouts=tuple(frames.layouts[i] for i in kept),

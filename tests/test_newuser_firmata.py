@@ -80,7 +80,8 @@ def pyfirmata2_session() -> list[bytes]:
     uno.send_sysex(firmata_module.REPORT_FIRMWARE, [])  # the firmware query (pyfirmata2 has no method of its own)
     uno.send_sysex(firmata_module.CAPABILITY_QUERY, [])  # as its auto_setup asks
     uno.exit()  # reporting off (REPORT_ANALOG 0, REPORT_DIGITAL port 0), the servo pin back to OUTPUT
-    return uno.sp.writes
+    writes: list[bytes] = uno.sp.writes
+    return writes
 
 
 # what each frame of pyfirmata2_session is, by message class and fields
@@ -137,14 +138,12 @@ def test_what_we_encode_pyfirmata2_reads(fm: ModuleType) -> None:
 
 
 MESSAGES = st.one_of(
-    st.builds(lambda v: ("ReportVersionResponse", {"major": v[0], "minor": v[1]}), st.tuples(*[st.integers(0, 127)] * 2)),
     st.builds(
-        lambda n, v: (f"AnalogMessage{n}Response", {"value": v}), st.integers(0, 15), st.integers(0, 16383)
+        lambda a, b: ("ReportVersionResponse", {"major": a, "minor": b}), st.integers(0, 127), st.integers(0, 127)
     ),
+    st.builds(lambda n, v: (f"AnalogMessage{n}Response", {"value": v}), st.integers(0, 15), st.integers(0, 16383)),
     st.builds(lambda n, v: (f"DigitalMessage{n}Response", {"value": v}), st.integers(0, 15), st.integers(0, 255)),
-    st.builds(
-        lambda text: ("StringDataResponse", {"text": text}), st.lists(st.integers(0, 16383), max_size=6)
-    ),
+    st.builds(lambda text: ("StringDataResponse", {"text": text}), st.lists(st.integers(0, 16383), max_size=6)),
     st.builds(lambda c: ("AnalogMappingResponseResponse", {"channels": c}), st.lists(st.integers(0, 127), max_size=6)),
 )
 
@@ -178,6 +177,18 @@ def test_a_command_byte_where_data_belongs_is_no_data(fm: ModuleType) -> None:
     assert parser.feed(bytes.fromhex("e0 7f f9 02 05")) == [fm.ReportVersionResponse(major=2, minor=5)]
 
 
+def test_a_frame_no_command_of_its_direction_has_is_refused_by_its_code(fm: ModuleType) -> None:
+    """A finding fixed: with layouts chosen by command, a sysex frame was first read in the headerless layout (the
+    refusal named code 0xf0, the sysex start), and a code no command of the direction has was "not sent in layout
+    'midi'"; now the header's layout is tried first and such a code is an unknown command, as in one layout."""
+    with pytest.raises(DecodeError, match=r"^unknown command 0x6a$"):  # ANALOG_MAPPING_RESPONSE, read as a request
+        fm.decode(bytes.fromhex("f0 6a 7f f7"), fm.Direction.REQUEST)
+    with pytest.raises(DecodeError, match=r"^unknown command 0xf4$"):  # SET_PIN_MODE, read as a response
+        fm.decode(bytes.fromhex("f4 0d 01"), fm.Direction.RESPONSE)
+    with pytest.raises(DecodeError, match=r"^code 0x79 is not sent in layout 'midi'$"):  # REPORT_FIRMWARE's code
+        fm.decode(bytes.fromhex("79"), fm.Direction.REQUEST)
+
+
 def test_pyfirmata2_asks_the_sim(monkeypatch: pytest.MonkeyPatch) -> None:
     """pyfirmata2's own Board (no 5 s wait for a reset) on the pseudo-terminal `serialspec sim` serves: it asks for
     the protocol version and the firmware, and its iterate() reads the answers."""
@@ -202,7 +213,7 @@ def test_bits_on_a_command_element_are_refused(tmp_path: Path) -> None:
     path = tmp_path / "channel.yaml"
     path.write_text(CHANNEL.replace("PIN", "bits: {kind: {bits: [7, 4]}, pin: {bits: [3, 0]}}"), "utf-8")
     with pytest.raises(SpecErrors, match=r"command\.bits: `bits` belongs to an address, status or value element"):
-        load_protocol(path)
+        load_protocol(str(path))
 
 
 CHANNEL = """
@@ -261,7 +272,7 @@ def test_an_encoding_on_text_is_refused(tmp_path: Path) -> None:
     path = tmp_path / "firmata_text14.yaml"
     path.write_text(TEXT14, "utf-8")
     with pytest.raises(SpecErrors, match=r"text\.encoding: `encoding` is how an integer is stored: a string has none"):
-        load_protocol(path)
+        load_protocol(str(path))
 
 
 @pytest.mark.xfail(

@@ -872,9 +872,10 @@ FRAME_ELEMENT = Obj(
             default=False,
             example=True,
         ),
-        "flags": Str("status: name of an entry in `flags:`."),
+        "flags": Str("status (address, value): name of an entry in `flags:`."),
         "bits": bit_fields(
-            "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
+            "status, address or value: bit fields packed into the element (DYNAMIXEL: alert bit 7, error number "
+            "6..0); refused on any other element, whose value no message carries."
         ),
         "covers": span(
             "checksum: the span of elements covered. Within a transparency span (all of it, or part) it sees the "

@@ -638,6 +638,7 @@ class FrameCodec:
         read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
         three keyed by the class's name, so the construct structs hold them without the message classes)."""
         self.layouts = tuple(layouts)
+        self.by_header = tuple(sorted(self.layouts, key=lambda each: not each.header))  # the headerless one last
         # the plain layouts the stream parser sizes frames in (a layout with optional elements: its variants), and
         # the index of the layout each comes from
         self.variants = tuple(variant for layout in self.layouts for variant in layout.variants)
@@ -684,7 +685,7 @@ class FrameCodec:
         """The layout whose header the frame starts with; the one headerless layout beside them takes the rest."""
         if len(self.layouts) == 1:
             return self.layouts[0]
-        for layout in sorted(self.layouts, key=lambda each: not each.header):
+        for layout in self.by_header:
             if frame.startswith(layout.header):
                 return layout
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
@@ -709,7 +710,7 @@ class FrameCodec:
             # another layout
             problem: DecodeError | None = None
             elsewhere: DecodeError | None = None
-            for layout in self.layouts:
+            for layout in self.by_header:  # a header's layout first: F0 starts a sysex, not a headerless code F0
                 if not frame.startswith(layout.header):
                     continue
                 try:
@@ -722,6 +723,8 @@ class FrameCodec:
                 if layout.codes is None or unwrapped.code in layout.codes:
                     return unwrapped
                 code = "no code" if unwrapped.code is None else f"code {unwrapped.code:#04x}"
+                if not any(other.codes is None or unwrapped.code in other.codes for other in self.layouts):
+                    elsewhere = elsewhere or DecodeError(f"unknown command {unwrapped.code:#04x}")  # as one layout's
                 elsewhere = elsewhere or DecodeError(f"{code} is not sent in layout {layout.name!r}")
             problem = problem or elsewhere
             if problem is None:

@@ -215,6 +215,8 @@ class FieldResolver(Pass):
         endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
         if kind in SCALARS or bit_run.width(kind):
             return self.scalar(common, spec, path, endian)
+        if spec.get("encoding", "plain") != "plain":  # a string's bytes as 7-bit pairs would decode as NUL-padded text
+            self.error((*path, "encoding"), f"`encoding` is how an integer is stored: a {kind} has none")
         if kind == "bytes":
             size = spec.get("size")
             if size is None:

@@ -198,9 +198,12 @@ class FramingPass(FieldResolver):
         broadcast = item.get("broadcast")
         if broadcast is not None and scalar is not None and not scalar.minimum <= broadcast <= scalar.maximum:
             self.error((*path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
+        for key in ("bits", "flags"):  # only a value the messages carry shows its bits: elsewhere they would be lost
+            if key in item and role not in VALUE_ROLES and role in ROLES:
+                self.error((*path, key), f"`{key}` belongs to an address, status or value element, not a {role}")
         bits: tuple[Any, ...] = ()
         bits_class = ""
-        if "bits" in item and scalar is not None:
+        if "bits" in item and scalar is not None and role in VALUE_ROLES:
             common = {"name": name, "description": "", "description_cn": "", "inferred": ""}
             resolved = self.scalar(common, {"type": scalar.name, "bits": item["bits"]}, path, endian)
             bits, bits_class = resolved.bits, resolved.bits_class

@@ -25,25 +25,33 @@ generate: $(STAMP) test-tools
 # Programs the tests drive as a user would: tshark (the Wireshark dissectors) and tmux (`serialspec watch` on a
 # screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
 # are skipped, saying why.
-# The C target's tests also build with clang, with gcc -m32 (gcc-multilib: 32-bit size_t and long) and for big-endian
-# PowerPC (a cross gcc; qemu-user runs the programs): installed the same way. The Arm gcc `make bench-c` measures
-# the C's flash with (gcc-arm-none-eabi, newlib-nano included) is installed by `make bench-tools`: no test needs it.
+# The C target's tests also build with clang, with gcc -m32 (32-bit size_t and long: the 32-bit libc and libgcc,
+# without gcc-multilib, which Debian will not install beside a cross gcc) and for big-endian PowerPC (a cross gcc;
+# qemu-user runs the programs): installed the same way, each group on its own, so one that cannot be installed
+# leaves the others. The Arm gcc `make bench-c` measures the C's flash with (gcc-arm-none-eabi, newlib-nano
+# included) is installed by `make bench-tools`: no test needs it.
 TEST_TOOLS := tshark tmux
-# apt-get install of the packages in $$missing, as root; elsewhere it says which tests are skipped
+# apt-get install of the packages in $$missing (apt-get options in $$options), as root; elsewhere it says which
+# tests are skipped
 INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
 	if [ "$$(id -u)" != 0 ] || ! command -v apt-get >/dev/null; then \
 		echo "not installed:$$missing (apt-get as root installs them): the tests that need them are skipped"; exit 0; fi; \
 	echo "installing$$missing (apt-get)"; \
 	export DEBIAN_FRONTEND=noninteractive; \
-	apt-get -o DPkg::Lock::Timeout=300 install -y -q $$missing >/dev/null 2>&1 || { apt-get -o DPkg::Lock::Timeout=300 update -q >/dev/null 2>&1 && \
-		apt-get -o DPkg::Lock::Timeout=300 install -y -q $$missing >/dev/null 2>&1; } || \
+	apt-get -o DPkg::Lock::Timeout=300 install -y -q $$options $$missing >/dev/null 2>&1 || { apt-get -o DPkg::Lock::Timeout=300 update -q >/dev/null 2>&1 && \
+		apt-get -o DPkg::Lock::Timeout=300 install -y -q $$options $$missing >/dev/null 2>&1; } || \
 		echo "could not install$$missing: the tests that need them are skipped"
+# the 32-bit libgcc of the host's gcc (lib32gcc-12-dev for gcc 12)
+LIB32GCC = lib32gcc-$$(gcc -dumpversion 2>/dev/null | cut -d. -f1)-dev
 test-tools:
 	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
 	command -v clang >/dev/null || missing="$$missing clang"; \
-	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing="$$missing gcc-multilib"; \
-	command -v powerpc-linux-gnu-gcc >/dev/null || missing="$$missing gcc-powerpc-linux-gnu libc6-dev-powerpc-cross"; \
+	$(INSTALL_MISSING)
+	@missing=""; command -v powerpc-linux-gnu-gcc >/dev/null || missing="$$missing gcc-powerpc-linux-gnu libc6-dev-powerpc-cross"; \
 	command -v qemu-ppc >/dev/null || missing="$$missing qemu-user"; \
+	$(INSTALL_MISSING)
+	@missing=""; options=--no-install-recommends; \
+	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing=" libc6-dev-i386 $(LIB32GCC)"; \
 	$(INSTALL_MISSING)
 
 bench-tools: test-tools

@@ -97,7 +97,7 @@ def test_a_shipped_spec_the_c_target_refuses_gets_one_line(g: Generated, tmp_pat
 
 @cache
 def m32_builds() -> bool:
-    """gcc -m32 links a program here (gcc-multilib installed)."""
+    """gcc -m32 links a program here (the 32-bit libc and libgcc installed)."""
     import tempfile
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -123,7 +123,7 @@ def compiler(build: str) -> list[str]:
         return [CLANG]
     if build == "gcc-m32":
         if not m32_builds():
-            pytest.skip("gcc -m32 cannot link (apt-get install gcc-multilib; make c-check installs it as root)")
+            pytest.skip("gcc -m32 cannot link (apt-get install libc6-dev-i386 lib32gcc-12-dev; make generate installs them as root)")
         return [GCC, "-m32"]
     if build == "powerpc-be":
         if PPC_GCC is None or QEMU_PPC is None:

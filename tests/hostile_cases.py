@@ -1160,6 +1160,13 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "examples.move_request: the frame decodes to other values: angle is 100, not 101",
     ),
     (
+        "example value by its enum name",  # a newcomer's first example: the member's name where the wire value goes
+        "tiny",
+        put("examples/move_request/fields/mode", "fast"),
+        "examples.move_request: the frame decodes to other values: mode is 1, not 'fast' (examples record wire values: "
+        "write 1, which is fast)",
+    ),
+    (
         "example value missing",
         "tiny",
         drop("examples/move_request/fields/time"),

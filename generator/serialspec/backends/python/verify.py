@@ -20,16 +20,25 @@ from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.text import texts
 
 
-def _difference(found: dict[str, Any], recorded: dict[str, object]) -> str:
+def _difference(found: dict[str, Any], recorded: dict[str, object], message: object = None) -> str:
     names = [*recorded, *(k for k in found if k not in recorded)]
     wrong = [
-        f"{name} is {found[name]!r}, not {recorded[name]!r}"
+        f"{name} is {found[name]!r}, not {recorded[name]!r}{_raw_hint(getattr(message, name, None), recorded[name])}"
         if name in found and name in recorded
         else (f"{name} is not in the frame" if name in recorded else f"{name}={found[name]!r} is not recorded")
         for name in names
         if found.get(name, ...) != recorded.get(name, ...)
     ]
     return "; ".join(wrong)
+
+
+def _raw_hint(found: object, recorded: object) -> str:
+    """Where a value was recorded by its enum member's name (`found`: the decoded message's member): examples record
+    what the wire carries."""
+    name = getattr(found, "name", None)
+    if isinstance(recorded, str) and isinstance(name, str) and name.lower() == recorded.lower():
+        return f" (examples record wire values: write {int(found)}, which is {recorded})"  # type: ignore[call-overload]
+    return ""
 
 
 class _Checker:
@@ -60,7 +69,7 @@ class _Checker:
         # an optional frame element not sent (None) need not be recorded
         found_fields = {k: v for k, v in message.to_fields().items() if v is not None or k in fields}
         if found_fields != fields:
-            return f"the frame decodes to other values: {_difference(found_fields, fields)}"
+            return f"the frame decodes to other values: {_difference(found_fields, fields, message)}"
         return ""
 
     def asked(self, example: Example) -> Any:

@@ -226,7 +226,9 @@ def uart(sim_path: str) -> Iterator[TmcComUart]:
 
 def test_the_peer_reads_and_writes_registers_of_the_sim(uart: TmcComUart) -> None:
     assert uart.read_int(0x06)[0] >> 24 == 0x21  # IOIN VERSION
+    count = uart.read_int(0x02)[0]  # IFCNT
     assert uart.write_reg(0x13, 12345)
+    assert uart.read_int(0x02)[0] == (count + 1) % 256
     assert uart.read_int(0x13)[0] == 12345
     assert uart.write_reg(0x22, -1000)  # VACTUAL: signed, sent sign-extended
     assert uart.read_int(0x22)[0] == -1000
@@ -314,3 +316,61 @@ def test_writing_0_to_gstat_clears_no_flag(tmc: ModuleType) -> None:
     sim.handle(tmc.WriteGstatRequest(sync=sync, node=0, gstat=zero))
     [(_, frame)] = sim.handle(tmc.ReadGstatRequest(sync=sync, node=0))
     assert tmc.decode(frame, tmc.Direction.RESPONSE).gstat.reset == 1  # set after power-up until a 1 clears it
+
+
+def test_the_c_and_the_dissector_read_tmc2209(tmp_path: Path) -> None:
+    """The C (strict flags) decodes every example to its values and encodes it back (its check_vectors program);
+    tshark shows a random message of each command as `decode` does, and flags a corrupt CRC."""
+    import subprocess
+
+    from serialspec.cli import main as serialspec_main
+    from test_c_backend import FLAGS, GCC
+    from test_wireshark import TSHARK, through_tshark
+
+    if GCC is not None:
+        assert serialspec_main(["generate", str(SPEC), "--target", "c", "--out", str(tmp_path)]) == 0
+        c = tmp_path / "tmc2209"
+        sources = [str(c / name) for name in ("test/check_vectors.c", "tmc2209.c", "tmc2209_json.c")]
+        built = subprocess.run([GCC, *FLAGS, *sources, "-o", str(tmp_path / "check")], capture_output=True, text=True)
+        assert built.returncode == 0 and not built.stderr, built.stderr
+        checked = subprocess.run([str(tmp_path / "check")], capture_output=True, text=True, timeout=60)
+        assert checked.stdout == "tmc2209: 10 vectors, 0 refused frames, 0 failed\n", checked.stdout + checked.stderr
+    if TSHARK is not None:
+        through_tshark(tmp_path, [SPEC.read_text(encoding="utf-8")], corrupt=True)
+
+
+def test_ifcnt_counts_the_writes_taken_modulo_256(tmc: ModuleType) -> None:
+    """`steps: [ifcnt]` with `modulo: {ifcnt: 256}` on every write (a device key added for this spec): IFCNT counts
+    the writes, wraps past 255, and reads do not count."""
+    sim = importlib.import_module("tmc2209.simulator").Tmc2209Simulator(ids=[0])
+    sync = tmc.SyncBits(nibble=5, reserved=5)
+
+    def ifcnt() -> int:
+        [(_, frame)] = sim.handle(tmc.ReadIfcntRequest(sync=sync, node=0))
+        return int(tmc.decode(frame, tmc.Direction.RESPONSE).ifcnt)
+
+    assert ifcnt() == 0
+    sim.handle(tmc.WriteTpowerdownRequest(sync=sync, node=0, tpowerdown=10))
+    sim.handle(tmc.WriteVactualRequest(sync=sync, node=0, vactual=-3))
+    assert ifcnt() == 2
+    sim.devices[0].set("ifcnt", 255)
+    sim.handle(tmc.WriteSgthrsRequest(sync=sync, node=0, sgthrs=1))
+    assert ifcnt() == 0
+    sim.handle(tmc.WriteSgthrsRequest(sync=sync, node=3, sgthrs=1))  # another node's: not this driver's
+    assert ifcnt() == 0
+
+
+def test_steps_names_a_state_variable_or_memory_entry(tmp_path: Path) -> None:
+    from serialspec.lang import SpecErrors, load_protocol
+
+    text = SPEC.read_text("utf-8").replace(
+        "write_tpowerdown: {writes: [tpowerdown], steps: [ifcnt]",
+        "write_tpowerdown: {writes: [tpowerdown], steps: [ifcn]",
+    )
+    spec = tmp_path / "tmc2209.yaml"
+    spec.write_text(text, "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "tmc2209.yaml")
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1, lines
+    assert "device.commands.write_tpowerdown.steps: unknown state variable 'ifcn'" in lines[0]

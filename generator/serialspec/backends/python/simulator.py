@@ -43,6 +43,7 @@ BEHAVIOUR_ARGUMENTS = (
     "buffered",
     "commits",
     "stops",
+    "steps",
     "wraps",
     "modulo",
     "restores",

@@ -210,7 +210,7 @@ def test_the_stream_parser_reads_a_noisy_stream_of_the_peers_frames(tmc: ModuleT
 
 @pytest.fixture(scope="module")
 def sim_path() -> Iterator[str]:
-    with serve(str(SPEC), 0, options=["--echo"]) as path:
+    with serve(str(SPEC), 0, 2, options=["--echo"]) as path:
         yield path
 
 
@@ -374,3 +374,45 @@ def test_steps_names_a_state_variable_or_memory_entry(tmp_path: Path) -> None:
     lines = str(caught.value).splitlines()
     assert len(lines) == 1, lines
     assert "device.commands.write_tpowerdown.steps: unknown state variable 'ifcn'" in lines[0]
+
+
+def test_serialspec_scan_finds_the_drivers_of_the_sim(sim_path: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """`device.presence` reads IOIN with the sync byte's bit fields given as `sync.nibble` and `sync.reserved` (a
+    presence request's frame values and bit fields can now be given; before, scan failed when it ran)."""
+    from serialspec.cli import main as serialspec_main
+
+    assert serialspec_main(["scan", str(SPEC), "--port", sim_path, "--ids", "0-2", "--timeout", "0.2"]) == 0
+    assert capsys.readouterr().out.splitlines() == ["id   0  115200 baud", "id   2  115200 baud"]
+
+
+def test_the_peers_scan_finds_the_drivers_of_the_sim(sim_path: str) -> None:
+    from tmc_driver.reg._tmc2209_reg import Ioin
+
+    com = TmcComUart(sim_path, 115200)
+    com.tmc_logger = LOG
+    com.init()
+    com.ser.timeout = 0.2  # a node that is not there: the peer waits this long for its 12 bytes
+    try:
+        assert com.scan_for_devices([Ioin], range(3)) == [(0, "TMC220X"), (2, "TMC220X")]
+    finally:
+        com.deinit()
+
+
+def test_a_presence_request_missing_a_value_is_one_spec_error(tmp_path: Path) -> None:
+    """Found writing this spec: a presence request whose frame carries a value the spec gives no way to fill (the sync
+    byte, a plain `role: value` element) passed `check`, and `serialspec scan` failed when it ran; nor could
+    `fields` name a frame value or a bit field."""
+    from serialspec.lang import SpecErrors, load_protocol
+
+    spec = tmp_path / "tmc2209.yaml"
+    spec.write_text(SPEC.read_text("utf-8").replace("    fields: {sync.nibble: 5, sync.reserved: 0}\n", ""), "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "tmc2209.yaml")
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1, lines
+    assert "device.presence.fields: the read_ioin request needs a value for sync: give it here" in lines[0]
+    assert "(bit fields as sync.nibble, sync.reserved)" in lines[0]
+    spec.write_text(SPEC.read_text("utf-8").replace("sync.reserved: 0}", "sync.reservd: 0}"), "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "tmc2209.yaml")
+    assert "device.presence.fields.sync.reservd: 'sync' has no bit field 'reservd'" in str(caught.value)

@@ -1374,7 +1374,12 @@ PRESENCE = Obj(
             "The command (or command.subcommand) a device answers whenever it is there: any reply, an error reply "
             "too, means a device has that id (FEETECH and DYNAMIXEL PING, a Modbus register read)."
         ),
-        "fields": MapOf(Num(), "Request field -> its value, besides the id (a read's address and count)."),
+        "fields": MapOf(
+            Num(),
+            "Request field (or frame value, such as a sync byte) -> its value, besides the id (a read's address and "
+            "count); a bit field as `field.bit_field` (TMC2209: `sync.nibble: 5`). Every value of the request that "
+            "the spec gives no default, constant or derivation for must be here.",
+        ),
         "ids": ListOf(
             Int(),
             "The first and last id `serialspec scan` asks by default (default: the device's id range, without the "

@@ -537,6 +537,8 @@ class DevicePass(Pass):
         """One error naming the values a presence request needs that neither `fields` nor the spec gives (a default,
         a constant, a value derived from others): `scan` could not build the request."""
         named = {name.partition(".")[0] for name in given}
+        # a frame element with a mistake of its own reported already is not reported again here
+        named |= {str(p[p.index("elements") + 1]) for p in self.ctx.reported if "elements" in p[:-1]}
         missing = [
             name
             for name, f in self.request_values(request).items()

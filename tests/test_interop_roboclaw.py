@@ -214,7 +214,7 @@ def test_a_reply_without_its_request_is_refused_in_one_line(capsys: pytest.Captu
 
 def test_read_requests_carry_no_crc_and_codes_keep_to_their_layout() -> None:
     assert rc.encode(rc.ReadMainBatteryRequest(address=0x80)) == bytes.fromhex("80 18")
-    with pytest.raises(DecodeError, match="shorter than the smallest write frame"):
+    with pytest.raises(DecodeError, match="shorter than the 4 bytes a write frame has besides its content"):
         rc.decode(bytes.fromhex("80 20"), "request")  # duty M1 is a write: it needs data and a CRC
     with pytest.raises(DecodeError, match="longer than the read frame"):
         rc.decode(bytes.fromhex("80 18 88 a1"), "request")  # 80 18 is a read: two bytes, no CRC (not a write's)

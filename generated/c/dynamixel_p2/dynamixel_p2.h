@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "df95a0da804889d223afedd3d3f0313475a8a512ef46486160a0b5373235d959"
+#define DYNAMIXEL_P2_SPEC_SHA256 "78962b576abb6e4c3a1220762434570186a931060d5bd8b044c1858557ae7a6e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

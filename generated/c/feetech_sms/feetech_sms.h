@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "835fddc02bfd173532c1cb2099f33751026055df6a3a04ee65a4451f50d9b469"
+#define FEETECH_SMS_SPEC_SHA256 "c4124573153671c76dd57893a1259753d5328d3e49ec99e9a850a18fce9af767"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

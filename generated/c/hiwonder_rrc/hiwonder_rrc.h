@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "d24e937950a4b152c98de5c91042a8ddc922f8237072ef9f612854868bb710e8"
+#define HIWONDER_RRC_SPEC_SHA256 "dca72288abd544b32b6efcfde8380c80b4922b17541033f9a7fe53d8f2f5b90e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

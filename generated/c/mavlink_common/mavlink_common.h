@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "80f6d20364111b428e0a3faedd04663f931e35330f9dec4946ebcbbd0b71cb26"
+#define MAVLINK_COMMON_SPEC_SHA256 "0991aed154cfea722dafc7640b8fa21af7c82bf9b11c54c85a1263ebf41ae776"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "0ecb008c0892ef3b63711086cb6aee7e234a3bd3fb3c253f73b70b7868984d07"
+#define VESC_SPEC_SHA256 "7b96755e9045f1340c9d3263d62d9265a0750c94a8188e848203ee55c189d1a3"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

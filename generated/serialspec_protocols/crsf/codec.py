@@ -467,7 +467,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     """One complete request frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 4:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a request frame has besides its content")
     end = n - 1
     if frame[0] != 0xc8:
         raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
@@ -539,7 +539,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     """One complete response frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 4:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a response frame has besides its content")
     end = n - 1
     if frame[0] != 0xc8:
         raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
@@ -612,7 +612,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 pass  # a frame of another size: the general path says what is wrong
         n = len(frame)
         if n < 4:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a request frame has besides its content")
         end = n - 1
         if frame[0] != 0xc8:
             raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
@@ -640,7 +640,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 pass  # a frame of another size: the general path says what is wrong
         n = len(frame)
         if n < 4:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a response frame has besides its content")
         end = n - 1
         if frame[0] != 0xc8:
             raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")

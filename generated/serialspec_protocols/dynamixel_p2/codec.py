@@ -474,7 +474,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     """One complete request frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 9:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 10 bytes a request frame has besides its content")
     end = n - 2
     buf = frame
     if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
@@ -552,7 +552,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     """One complete response frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 9:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 11 bytes a response frame has besides its content")
     end = n - 2
     buf = frame
     if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
@@ -630,7 +630,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 10 bytes a request frame has besides its content")
         end = n - 2
         buf = frame
         if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
@@ -662,7 +662,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 11 bytes a response frame has besides its content")
         end = n - 2
         buf = frame
         if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span

@@ -2173,7 +2173,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 5 bytes a request frame has besides its content")
         end = n - 1
         if frame[:2] != b'\x12L':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected 12 4c")
@@ -2206,7 +2206,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 5 bytes a response frame has besides its content")
         end = n - 1
         if frame[:2] != b'\x05\x1c':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected 05 1c")

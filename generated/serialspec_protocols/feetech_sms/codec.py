@@ -530,7 +530,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 6:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a request frame has besides its content")
         end = n - 1
         if frame[:2] != b'\xff\xff':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected ff ff")
@@ -554,7 +554,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 6:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a response frame has besides its content")
         end = n - 1
         if frame[:2] != b'\xff\xff':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected ff ff")

@@ -2329,7 +2329,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 5 bytes a request frame has besides its content")
         end = n - 1
         if frame[:2] != b'\xaaU':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected aa 55")
@@ -2356,7 +2356,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 5 bytes a response frame has besides its content")
         end = n - 1
         if frame[:2] != b'\xaaU':
             raise DecodeError(f"header is {frame[:2].hex(' ')}, expected aa 55")

@@ -561,7 +561,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
         return _decode_request_engine(frame, expect)
     n = len(frame)
     if n < 12:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 12 bytes a request frame has besides its content")
     end = n - 2
     if frame[0] != 0xfd:
         raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
@@ -658,7 +658,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
         return _decode_response_engine(frame, expect)
     n = len(frame)
     if n < 12:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 12 bytes a response frame has besides its content")
     end = n - 2
     if frame[0] != 0xfd:
         raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
@@ -724,7 +724,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             return _decode_request_engine(frame, expect)
         n = len(frame)
         if n < 12:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 12 bytes a request frame has besides its content")
         end = n - 2
         if frame[0] != 0xfd:
             raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
@@ -758,7 +758,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             return _decode_response_engine(frame, expect)
         n = len(frame)
         if n < 12:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 12 bytes a response frame has besides its content")
         end = n - 2
         if frame[0] != 0xfd:
             raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")

@@ -699,7 +699,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     """One complete request frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 4:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a request frame has besides its content")
     end = n - 2
     v_unit = frame[0]
     if v_unit > 247:
@@ -767,7 +767,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     """One complete response frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 4:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a response frame has besides its content")
     end = n - 2
     v_unit = frame[0]
     if v_unit > 247:
@@ -830,7 +830,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a request frame has besides its content")
         end = n - 2
         v_unit = frame[0]
         if v_unit > 247:
@@ -850,7 +850,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+            raise DecodeError(f"frame of {n} bytes is shorter than the 4 bytes a response frame has besides its content")
         end = n - 2
         v_unit = frame[0]
         if v_unit > 247:

@@ -426,7 +426,7 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     """One complete short frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 6:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a short frame has besides its content")
     end = n - 3
     if frame[end + 2] != 0x03:
         raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -450,7 +450,7 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     """One complete long frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 7:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 7 bytes a long frame has besides its content")
     end = n - 3
     if frame[end + 2] != 0x03:
         raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -542,7 +542,7 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     """One complete short frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 6:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a short frame has besides its content")
     end = n - 3
     if frame[end + 2] != 0x03:
         raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -566,7 +566,7 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     """One complete long frame, checked and taken apart; its content decoded."""
     n = len(frame)
     if n < 7:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+        raise DecodeError(f"frame of {n} bytes is shorter than the 7 bytes a long frame has besides its content")
     end = n - 3
     if frame[end + 2] != 0x03:
         raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -652,7 +652,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:
-                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+                raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a short frame has besides its content")
             end = n - 3
             if frame[end + 2] != 0x03:
                 raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -673,7 +673,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame.startswith(b'\x03'):
             n = len(frame)
             if n < 7:
-                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+                raise DecodeError(f"frame of {n} bytes is shorter than the 7 bytes a long frame has besides its content")
             end = n - 3
             if frame[end + 2] != 0x03:
                 raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -703,7 +703,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:
-                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+                raise DecodeError(f"frame of {n} bytes is shorter than the 6 bytes a short frame has besides its content")
             end = n - 3
             if frame[end + 2] != 0x03:
                 raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
@@ -724,7 +724,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame.startswith(b'\x03'):
             n = len(frame)
             if n < 7:
-                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+                raise DecodeError(f"frame of {n} bytes is shorter than the 7 bytes a long frame has besides its content")
             end = n - 3
             if frame[end + 2] != 0x03:
                 raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")

@@ -21,7 +21,7 @@ from typing import Any
 
 from serialspec.cli import port_options
 from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
-from serialspec.lang.model import Bytes, Direction, Presence, Protocol, replies_by_request, reply_to
+from serialspec.lang.model import Bytes, Direction, Presence, Protocol, Scalar, replies_by_request, reply_to
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
 
@@ -132,8 +132,25 @@ class Scanner:
         self.message(self.request, presence.fields, None if not presence.ids else presence.ids[0])
 
     def message(self, cls: Any, values: dict[str, float], device: int | None) -> Any:
-        """The presence (or model) request to `device`, checked as encode will check it."""
-        given = {name: int(value) if float(value).is_integer() else value for name, value in values.items()}
+        """The presence (or model) request to `device`, checked as encode will check it: the spec's values (bit fields
+        given as `field.bit_field` made into their class), the fields' defaults for the others."""
+        given: dict[str, Any] = {}
+        for name, value in values.items():
+            number = int(value) if float(value).is_integer() else value
+            base, _, bit = name.partition(".")
+            if bit:
+                given.setdefault(base, {})[bit] = number
+            else:
+                given[base] = number
+        spec = next(m for m in self.protocol.messages() if m.class_name == cls.__name__)
+        layout = self.protocol.framing.layouts[Direction.REQUEST]
+        scalars = [f for f in (*layout.value_elements, *spec.fields) if not isinstance(f, Scalar) or not f.hidden]
+        for f in scalars:
+            if isinstance(f, Scalar) and f.default is not None:
+                given.setdefault(f.name, int(f.default) if float(f.default).is_integer() else f.default)
+            bits_class = getattr(f, "bits_class", "")
+            if bits_class and isinstance(given.get(f.name), dict):
+                given[f.name] = getattr(self.package, bits_class).from_fields(given[f.name])
         if device is not None:
             given[self.presence.id_field] = device
         try:

@@ -1229,6 +1229,13 @@ DEVICE_COMMAND = Obj(
             description="The device moves a state variable to a target, over a duration or at a speed.",
         ),
         "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
+        "steps": ListOf(
+            Str(),
+            "State variables or memory entries the command adds 1 to each time the device carries out a request "
+            "that is not refused: a count of the writes taken (the TMC2209's IFCNT: `steps: [ifcnt]`, with "
+            "`modulo: {ifcnt: 256}` for a count that wraps past 255).",
+            example=["ifcnt"],
+        ),
         "wraps": MapOf(
             Num(),
             "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
@@ -1367,7 +1374,12 @@ PRESENCE = Obj(
             "The command (or command.subcommand) a device answers whenever it is there: any reply, an error reply "
             "too, means a device has that id (FEETECH and DYNAMIXEL PING, a Modbus register read)."
         ),
-        "fields": MapOf(Num(), "Request field -> its value, besides the id (a read's address and count)."),
+        "fields": MapOf(
+            Num(),
+            "Request field (or frame value, such as a sync byte) -> its value, besides the id (a read's address and "
+            "count); a bit field as `field.bit_field` (TMC2209: `sync.nibble: 5`). Every value of the request that "
+            "the spec gives no default, constant or derivation for must be here.",
+        ),
         "ids": ListOf(
             Int(),
             "The first and last id `serialspec scan` asks by default (default: the device's id range, without the "

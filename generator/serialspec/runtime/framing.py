@@ -275,7 +275,10 @@ class Layout:
             if variant.admits(frame):
                 return variant
         smallest = min(v.overhead for v in self.variants)
-        raise DecodeError(f"frame of {len(frame)} bytes is shorter than the smallest {self.name} frame ({smallest})")
+        raise DecodeError(
+            f"frame of {len(frame)} bytes is shorter than the {smallest} bytes a {self.name} frame has besides its "
+            "content"
+        )
 
     # --- encoding -------------------------------------------------------------------------------------------------
 
@@ -388,7 +391,10 @@ class Layout:
         before, after = plan["before"], plan["after"]
         n = len(frame)
         if n < before + after:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest {self.name} frame ({self.overhead})")
+            raise DecodeError(
+                f"frame of {n} bytes is shorter than the {self.overhead} bytes a {self.name} frame has besides its "
+                "content"
+            )
         elements = self.elements
         plain: list[bytes] = [b""] * len(elements)
         for index, start, stop in plan["head"]:

@@ -23,7 +23,7 @@ from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import asked_commands, request_response_pairs
-from serialspec.backends.python.content import annotation
+from serialspec.backends.python.content import annotation, element_scalar
 from serialspec.backends.python.kinds import list_item_type
 from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
@@ -71,29 +71,7 @@ def address_of(protocol: Protocol, request: Message | None = None) -> tuple[str,
 def value_fields(protocol: Protocol, message: Message) -> list[Field]:
     """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them."""
     layout = protocol.framing.layouts[message.direction]
-    frame = [
-        Scalar(
-            e.name,
-            e.description,
-            "",
-            "",
-            e.type,
-            "<",
-            "",
-            None,
-            e.minimum,
-            e.maximum,
-            None,
-            None,
-            None,
-            e.flags,
-            (),
-            "",
-            False,
-        )
-        for e in layout.value_elements
-        if e.type is not None
-    ]
+    frame = [element_scalar(e) for e in layout.value_elements if e.type is not None]
     return [*frame, *(f for f in message.fields if not (isinstance(f, Scalar) and f.hidden))]
 
 

@@ -63,6 +63,7 @@ from serialspec.lang.model import (
     Array,
     Bytes,
     Direction,
+    FrameElement,
     Group,
     List,
     Message,
@@ -105,6 +106,31 @@ def bound(f: Scalar, value: float) -> str:
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
+
+
+def element_scalar(element: FrameElement) -> Scalar:
+    """A frame-level value element (SMS id, error, a sync byte with bit fields) as the scalar field messages carry,
+    its bit fields and flags included: the codec, the client and the sims see one field."""
+    assert element.type is not None
+    return Scalar(
+        element.name,
+        element.description,
+        "",
+        "",
+        element.type,
+        element.endian,
+        "",
+        None,
+        element.minimum,
+        element.maximum,
+        None,
+        None,
+        None,
+        element.flags,
+        element.bits,
+        element.bits_class,
+        False,
+    )
 
 
 def annotation(f: SpecField) -> str:
@@ -224,37 +250,13 @@ class PackageCode:
         """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields; an error reply
         (Modbus exception) also carries the code of the request it refuses, named after the command element."""
         layout = self.protocol.framing.layouts[direction]
-        values = []
         elements = list(layout.value_elements)
         error = self.protocol.error_reply
         if message is not None and message.error_reply and error is not None:
             element = next(e for e in layout.elements if e.name == error.element)
             top = error.flag - 1 if error.flag else element.maximum  # an error header: any code of the element
             elements.append(replace(element, minimum=0, maximum=top, flags=None))
-        for element in elements:
-            assert element.type is not None
-            values.append(
-                Scalar(
-                    element.name,
-                    element.description,
-                    "",
-                    "",
-                    element.type,
-                    element.endian,
-                    "",
-                    None,
-                    element.minimum,
-                    element.maximum,
-                    None,
-                    None,
-                    None,
-                    element.flags,
-                    element.bits,
-                    element.bits_class,
-                    False,
-                )
-            )
-        return values
+        return [element_scalar(element) for element in elements]
 
     def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
         # Defaults only on a trailing run of fields that all have one: classes stay positional.

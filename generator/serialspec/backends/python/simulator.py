@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import replace
 from typing import Any, assert_never
 
@@ -42,6 +43,7 @@ BEHAVIOUR_ARGUMENTS = (
     "buffered",
     "commits",
     "stops",
+    "steps",
     "wraps",
     "modulo",
     "restores",
@@ -199,6 +201,24 @@ def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dic
     return {name: blank for name, blank in blanks.items() if blank != "0"}
 
 
+def bit_field_layouts(
+    protocol: Protocol, kept: Iterable[str], *messages: Message | None
+) -> dict[str, tuple[tuple[str, int, int], ...]]:
+    """The messages' fields made of bit fields that the device keeps (those `kept` names: read, written, stored or
+    reported, and any named like a memory entry or state variable) -> (bit field, lowest bit, highest bit)...: the
+    device keeps such a field as one integer (a register) and answers it bit field by bit field."""
+    device = protocol.device
+    assert device is not None
+    names = {*kept, *device.state, *(e.name for e in (device.memory.entries if device.memory else ()))}
+    return {
+        f.name: tuple((b.name, b.low, b.high) for b in f.bits)
+        for message in messages
+        if message is not None
+        for f in message.fields
+        if isinstance(f, Scalar) and f.bits and f.name in names
+    }
+
+
 def least(f: Field, siblings: tuple[Field, ...]) -> Field:
     """`f`, sized or counted by a sibling whose range starts above 0, as of that smallest size or count: its blank
     (none of it) would have a size the sizing field refuses."""
@@ -325,6 +345,10 @@ def simulator_module(protocol: Protocol) -> str:
             blanks = reply_blanks(protocol, refusal, filled) | blanks
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
+        keeps = (*behaviour.reads, *behaviour.writes, *behaviour.stores, *behaviour.reports) if behaviour else ()
+        bit_fields = bit_field_layouts(protocol, keeps, request, response)
+        if bit_fields:
+            args.append(f"bit_fields={bit_fields!r}")
         commands.append({"key": request.key, "args": args})
     spaces = [
         f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "
@@ -377,6 +401,9 @@ def simulator_module(protocol: Protocol) -> str:
         blanks = reply_blanks(protocol, response, set())
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
+        bit_fields = bit_field_layouts(protocol, send.values, response)
+        if bit_fields:
+            args.append(f"bit_fields={bit_fields!r}")
         sends.append(f"SendSpec({', '.join(args)}),")
     return render(
         "simulator.py.j2",

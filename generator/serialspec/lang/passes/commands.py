@@ -522,10 +522,16 @@ class Commands(FieldResolver):
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
                 if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                        shared = (
+                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
+                            "a code"
+                            if code is not None
+                            else f"{users[0][0].name!r} already sends requests without a code (the request frame has "
+                            "no command element); such requests"
+                        )
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
-                            "a code are told apart by their content size, which needs a length element",
+                            f"{shared} are told apart by their content size, which needs a length element",
                         )
                     else:
                         self.check_sizes_differ(what, users)

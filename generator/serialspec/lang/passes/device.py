@@ -438,6 +438,7 @@ class DevicePass(Pass):
         carries = self.carried_by(request)
         id_field = address_name if address_name in carries else ""
         fields = self.preset(value.get("fields"), (*path, "fields"), key, carries, id_field)
+        self.unset(request, {*fields, id_field}, (*path, "fields"), key)
         ids: tuple[int, int] | None = None
         if id_field:
             first, last = value.get("ids") or (low, high if broadcast != high else high - 1)
@@ -487,22 +488,68 @@ class DevicePass(Pass):
             description=str(value.get("description", "")),
         )
 
-    def carried_by(self, request: Message) -> set[str]:
-        """The values a request carries: its content fields and the frame's address elements."""
+    def request_values(self, request: Message) -> dict[str, Field | FrameElement]:
+        """The values a request carries: its content fields and the frame's values (address, status, a plain
+        value such as a sync byte), except a sequence number, which the client fills in."""
         framing = self.ctx.framing
         layouts = framing.layouts.values() if framing is not None else ()
-        elements = {e.name for layout in layouts for e in layout.value_elements if e.role == "address"}
-        return {f.name for f in request.fields} | elements
+        found: dict[str, Field | FrameElement] = {
+            e.name: e
+            for layout in layouts
+            for e in layout.value_elements
+            if Direction.REQUEST in e.directions and not e.sequence
+        }
+        return found | {f.name: f for f in request.fields}
+
+    def carried_by(self, request: Message) -> set[str]:
+        """The names of the values a request carries (request_values)."""
+        return set(self.request_values(request))
 
     def preset(self, value: Any, path: Path, key: str, carried: set[str], id_field: str) -> dict[str, float]:
+        """Request values given by name, a bit field as `field.bit_field` (`sync.nibble`)."""
         found = {}
         for name, number in (value or {}).items():
-            if name == id_field:
+            base, _, bit = str(name).partition(".")
+            if base == id_field:
                 self.error((*path, name), f"{name!r} is the device id: `scan` sets it")
-            elif name not in carried:
-                self.error((*path, name), f"{key} has no request field {name!r}")
+            elif base not in carried:
+                self.error((*path, name), f"{key} has no request field {base!r}")
+            elif bit and bit not in self.bit_names(base):
+                self.error((*path, name), f"{base!r} has no bit field {bit!r}")
             found[str(name)] = float(number)
         return found
+
+    def bit_names(self, name: str) -> set[str]:
+        """The bit fields of a request field or frame value of that name (any request's)."""
+        framing = self.ctx.framing
+        layouts = framing.layouts.values() if framing is not None else ()
+        found = [e.bits for layout in layouts for e in layout.value_elements if e.name == name]
+        found += [
+            f.bits
+            for c in self.ctx.commands
+            for m in c.messages()
+            for f in m.fields
+            if f.name == name and isinstance(f, Scalar)
+        ]
+        return {b.name for bits in found for b in bits}
+
+    def unset(self, request: Message, given: set[str], path: Path, key: str) -> None:
+        """One error naming the values a presence request needs that neither `fields` nor the spec gives (a default,
+        a constant, a value derived from others): `scan` could not build the request."""
+        named = {name.partition(".")[0] for name in given}
+        # a frame element with a mistake of its own reported already is not reported again here
+        named |= {str(p[p.index("elements") + 1]) for p in self.ctx.reported if "elements" in p[:-1]}
+        missing = [
+            name
+            for name, f in self.request_values(request).items()
+            if name not in named
+            and not (isinstance(f, Scalar) and (f.hidden or f.default is not None))
+            and not (isinstance(f, FrameElement) and f.type is None)
+        ]
+        if missing:
+            bits = [f"{name}.{b}" for name in missing for b in sorted(self.bit_names(name))]
+            hint = f" (bit fields as {', '.join(bits)})" if bits else ""
+            self.error(path, f"the {key} request needs a value for {', '.join(missing)}: give it here{hint}")
 
     def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
         """`address` (and each kind's) names an integer the requests carry; `reply`, `refused`, `status` name what
@@ -744,6 +791,7 @@ class DevicePass(Pass):
                 carried.append(str(name))
         return {
             "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "steps": tuple(known(str(n), (*path, "steps")) for n in item.get("steps") or ()),
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
             "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
             "restores": restores,

@@ -106,6 +106,7 @@ class CommandSpec:
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    steps: tuple[str, ...] = ()  # state variables (or memory entries) 1 is added to when the request is carried out
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
@@ -127,6 +128,9 @@ class CommandSpec:
     asks: tuple[str, dict[int, type[Message]]] | None = None
     # moves: where the state goes, a function of `get` (request fields, then memory and state); default: the target
     move_to: Callable[[Callable[[str], float]], float] | None = None
+    # request and response fields made of bit fields -> (bit field, lowest bit, highest bit)...: the device keeps
+    # such a field in memory or state as one integer (a register), and answers it bit field by bit field
+    bit_fields: dict[str, tuple[tuple[str, int, int], ...]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -144,11 +148,14 @@ class SendSpec:
     values: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     blanks: dict[str, Any] = field(default_factory=dict)  # as CommandSpec.blanks
     step: str = ""  # state variable: 1 is added to it before each send
+    bit_fields: dict[str, tuple[tuple[str, int, int], ...]] = field(default_factory=dict)  # as CommandSpec's
 
     @property
     def command(self) -> CommandSpec:
         """The message built as a reply is: its values, then the device's id, `reply` values, blanks."""
-        return CommandSpec(self.response, self.response, reports=self.values, blanks=self.blanks)
+        return CommandSpec(
+            self.response, self.response, reports=self.values, blanks=self.blanks, bit_fields=self.bit_fields
+        )
 
 
 @dataclass(frozen=True)
@@ -702,11 +709,13 @@ class Engine(FaultInjection):
         if command.moves and (not command.move_enabled_by or device.get(command.move_enabled_by)):
             self._move(device, command, given, written)
         for name, state in command.stores.items():
-            device.set(state, given[name])
+            device.set(state, packed(command.bit_fields.get(name), given[name]))
         for state, value in command.sets.items():
             device.set(state, value)
         for state in command.stops:
             device.set(state, device.get(state))
+        for state in command.steps if not refused else ():
+            device.set(state, device.get(state) + 1)
         for state, period in command.wraps.items():
             device.set(state, math.fmod(device.get(state), period))
         for state, period in command.modulo.items():
@@ -762,6 +771,9 @@ class Engine(FaultInjection):
             else:
                 blank = command.blanks.get(name, 0)
                 values[name] = blank(given) if callable(blank) else blank
+        for name, layout in command.bit_fields.items():
+            if name in values:
+                values[name] = unpacked(layout, values[name])
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
         nest(values, command.nothing_held if refused == "held" else self.spec.errors.get(refused, {}))
@@ -977,8 +989,23 @@ class Engine(FaultInjection):
                     if device.by_name[n].access != "r":
                         device.set(n, block[n])
             return next((r for r in reasons if r != "out_of_range"), reasons[0] if reasons else "")
-        device.set(name, given[name])
+        device.set(name, packed(command.bit_fields.get(name), given[name]))
         return ""
+
+
+def packed(layout: tuple[tuple[str, int, int], ...] | None, value: Any) -> Any:
+    """A field's value as the device keeps it: bit fields (a mapping) as the one integer they make up."""
+    if layout is None or not isinstance(value, Mapping):
+        return value
+    return sum((int(value.get(name, 0)) & ((1 << (high - low + 1)) - 1)) << low for name, low, high in layout)
+
+
+def unpacked(layout: tuple[tuple[str, int, int], ...], value: Any) -> Any:
+    """An integer the device keeps as the bit fields of a reply field made of them."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return value
+    whole = int(value)
+    return {name: (whole >> low) & ((1 << (high - low + 1)) - 1) for name, low, high in layout}
 
 
 def _items(value: Any) -> int:

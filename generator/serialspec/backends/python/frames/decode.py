@@ -59,8 +59,8 @@ def decode_lines(
     if smallest:
         body += [
             f"if n < {smallest}:",
-            f'    raise DecodeError(f"frame of {{n}} bytes is shorter than the smallest {layout.name} frame '
-            f'({layout.overhead})")',
+            f'    raise DecodeError(f"frame of {{n}} bytes is shorter than the {layout.overhead} bytes a {layout.name} '
+            f'frame has besides its content")',
         ]
     t = stuffing_of(layout)
     body.append(f"end = n - {positions.behind}" if positions.behind else "end = n")

@@ -21,7 +21,7 @@ from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.lang import SpecErrors, load_protocol
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from sim_process import serve
 
 pyfirmata2 = pytest.importorskip("pyfirmata2")
@@ -267,23 +267,31 @@ commands:
 
 
 def test_an_encoding_on_text_is_refused(tmp_path: Path) -> None:
-    """A finding fixed: `encoding: seven_bit` on a string (a new user's first try at STRING_DATA) was accepted and
-    ignored, so F0 71 48 00 69 00 F7 decoded as 'H\\x00i\\x00'; now the spec is refused in one line at its place."""
+    """A finding fixed: an encoding on a string was accepted and ignored (F0 71 48 00 69 00 F7 decoded as
+    'H\\x00i\\x00'); now seven_bit is text of 14-bit characters, and an encoding that makes no sense for text, or
+    seven_bit on text it cannot size, is refused in one line at its place."""
     path = tmp_path / "firmata_text14.yaml"
-    path.write_text(TEXT14, "utf-8")
-    with pytest.raises(SpecErrors, match=r"text\.encoding: `encoding` is how an integer is stored: a string has none"):
+    path.write_text(TEXT14.replace("seven_bit", "sign_magnitude"), "utf-8")
+    with pytest.raises(
+        SpecErrors, match=r"text\.encoding: `encoding` is how an integer is stored: a string takes only"
+    ):
+        load_protocol(str(path))
+    path.write_text(TEXT14.replace("size: rest", "size: 3"), "utf-8")
+    with pytest.raises(SpecErrors, match=r"text\.encoding: size 3: text of 14-bit characters is two bytes a"):
+        load_protocol(str(path))
+    path.write_text(TEXT14.replace("type: string, size: rest", "type: cstring"), "utf-8")
+    with pytest.raises(SpecErrors, match=r"text\.encoding: encoding seven_bit on text needs `size: rest`"):
         load_protocol(str(path))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: text of 14-bit characters (Firmata's STRING_DATA and REPORT_FIRMWARE's name: each "
-    "character as two 7-bit bytes, low first). `encoding: seven_bit` is for integers; a `string` takes no "
-    "encoding, so the spec gives such text as a group of 14-bit numbers (`char14`) and a user joins them",
-)
 def test_text_of_14_bit_characters(tmp_path: Path) -> None:
     path = tmp_path / "firmata_text14.yaml"
     path.write_text(TEXT14, "utf-8")
     module = generate_and_import(path, tmp_path / "out", "firmata_text14")
     message = module.decode(bytes.fromhex("f0 71 48 00 69 00 f7"), module.Direction.RESPONSE)
     assert message.text == "Hi"
+    assert module.encode(module.StringDataResponse(text="é\u3fff")) == bytes.fromhex("f0 71 69 01 7f 7f f7")
+    with pytest.raises(EncodeError, match=r"text: character 0 \(.*, 0x1f600\) is not a 14-bit character"):
+        module.encode(module.StringDataResponse(text="\U0001f600"))
+    with pytest.raises(DecodeError, match="text is not text of 14-bit characters: 3 bytes: an odd count"):
+        module.decode(bytes.fromhex("f0 71 48 00 69 f7"), module.Direction.RESPONSE)

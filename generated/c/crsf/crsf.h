@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "62a620453853469e2bc71dec701bf228eb0fee066f583cc80d0e6e4f204be79a"
+#define CRSF_SPEC_SHA256 "a8ffc05b1adc60a46abbf08f4c9552487835ccfbed1c84e0453a8cd03f8f2692"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "80f6d20364111b428e0a3faedd04663f931e35330f9dec4946ebcbbd0b71cb26"
+#define MAVLINK_COMMON_SPEC_SHA256 "ac90df55099240abd208511b234faab1c5819725431cff3614e1b8d8c88c1c91"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "a74186af7597e76f683ba194784a8513b595b2109fe78510ecb57b2cf15dae59"
+#define ROBOCLAW_SPEC_SHA256 "ce09201cbf629e0c50b918d55a9599ed1b60a93e425d4781e6d2df84be0e328f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

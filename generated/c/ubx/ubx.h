@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "ba81c823e107ad9dfc38158bebf67facc0f0ce19242597ec86f02b390cabe596"
+#define UBX_SPEC_SHA256 "69ecdae3a7fa403e5b50c4a4d3a5af278dca81d4d1f38289813d2774fbd31335"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

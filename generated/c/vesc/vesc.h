@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "0ecb008c0892ef3b63711086cb6aee7e234a3bd3fb3c253f73b70b7868984d07"
+#define VESC_SPEC_SHA256 "bf8ae093345f77bb7571a23bd4f159d6e3b40278ebb980c977cb3ab9167306d4"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -96,7 +96,11 @@ def _fields_values(
         elif isinstance(f, List):
             values[f.name] = draw(list_value(f, fields, scope))
         elif isinstance(f, Text):
-            if isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
+            if f.seven_bit:  # 14-bit characters (any, but the surrogates), two wire bytes each
+                chars = st.characters(max_codepoint=0x3FFF, exclude_categories=("Cs",))
+                least, most = (f.size // 2, f.size // 2) if isinstance(f.size, int) else (0, 6)
+                values[f.name] = draw(st.text(chars, min_size=least, max_size=most))
+            elif isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
                 text = draw(st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=f.size))
                 values[f.name] = text.rstrip(chr(f.pad))
             elif isinstance(f.size, int):

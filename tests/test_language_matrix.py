@@ -211,6 +211,13 @@ CASES: dict[str, Case] = {
     "encoding: plain, seven_bit": same(
         {"v": {"type": "i16", "encoding": "plain"}, "t": {"type": "u16", "encoding": "seven_bit"}, "w": "u8"}
     ),
+    # text of 14-bit characters (Firmata's STRING_DATA): fixed-size and rest
+    "encoding: seven_bit on a string": same(
+        {
+            "name": {"type": "string", "size": 4, "encoding": "seven_bit"},
+            "text": {"type": "string", "size": "rest", "encoding": "seven_bit"},
+        }
+    ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
     # bit fields (uN/iN of any width) packed MSB first into runs of whole bytes, every integer key on them, a
     # byte-sized integer inside an open run, a run in a group's items; in RTCM 3's frame: a 10-bit length after 6

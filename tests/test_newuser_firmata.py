@@ -5,9 +5,9 @@ golden frames; its Board.iterate reads ours; its Board drives `serialspec sim` o
 MIDI-style framing as two layouts chosen by command: channel and system messages (a command byte, bit 7 set, and as
 many data bytes as the command takes) beside sysex (F0, a sysex command, 7-bit data, F7, the trailer ending it).
 Every data byte is `encoding: seven_bit` (a u8 of 0..127, a u16 of 14 bits as two bytes, low first), so a command
-byte where data belongs is refused, as a Firmata reader would. What the language cannot say is pinned by a strict
-xfail each: a pin or port number in the low bits of the command byte (the spec has a command per channel instead),
-and text of 14-bit characters (REPORT_FIRMWARE's name and STRING_DATA are groups of 14-bit numbers)."""
+byte where data belongs is refused, as a Firmata reader would. REPORT_FIRMWARE's name and STRING_DATA are text of
+14-bit characters (`encoding: seven_bit` on a string). What the language cannot say is pinned by a strict xfail: a
+pin or port number in the low bits of the command byte (the spec has a command per channel instead)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.lang import SpecErrors, load_protocol
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from sim_process import serve
 
 pyfirmata2 = pytest.importorskip("pyfirmata2")
@@ -121,10 +121,9 @@ def test_what_we_encode_pyfirmata2_reads(fm: ModuleType) -> None:
     button = uno.get_pin("d:2:i")
     seen: list[Any] = []
     button.register_callback(seen.append)
-    name = tuple(fm.NameItem(char=ord(c)) for c in NAME)
     messages = [
         fm.ReportVersionResponse(major=2, minor=5),
-        fm.ReportFirmwareResponse(major=2, minor=5, name=name),
+        fm.ReportFirmwareResponse(major=2, minor=5, name=NAME),
         fm.AnalogMessage0Response(value=1023),
         fm.DigitalMessage0Response(value=0b100),
     ]
@@ -143,7 +142,10 @@ MESSAGES = st.one_of(
     ),
     st.builds(lambda n, v: (f"AnalogMessage{n}Response", {"value": v}), st.integers(0, 15), st.integers(0, 16383)),
     st.builds(lambda n, v: (f"DigitalMessage{n}Response", {"value": v}), st.integers(0, 15), st.integers(0, 255)),
-    st.builds(lambda text: ("StringDataResponse", {"text": text}), st.lists(st.integers(0, 16383), max_size=6)),
+    st.builds(
+        lambda text: ("StringDataResponse", {"text": text}),
+        st.text(st.characters(max_codepoint=0x3FFF, exclude_categories=("Cs",)), max_size=6),
+    ),
     st.builds(lambda c: ("AnalogMappingResponseResponse", {"channels": c}), st.lists(st.integers(0, 127), max_size=6)),
 )
 
@@ -155,8 +157,6 @@ def test_a_stream_of_mixed_messages_split_anywhere(fm: ModuleType, chosen: list[
     bytes no Firmata message starts with (a data byte where a command belongs, a sysex the spec does not have)."""
     messages = []
     for name, fields in chosen:
-        if name == "StringDataResponse":
-            fields = {"text": tuple(fm.StringDataResponseTextItem(char=c) for c in fields["text"])}
         messages.append(getattr(fm, name)(**fields))
     stream = b"\x05" + b"".join(fm.encode(m) + bytes.fromhex("f0 6e 01 f7") for m in messages)
     parser = fm.StreamParser(fm.Direction.RESPONSE)
@@ -267,23 +267,31 @@ commands:
 
 
 def test_an_encoding_on_text_is_refused(tmp_path: Path) -> None:
-    """A finding fixed: `encoding: seven_bit` on a string (a new user's first try at STRING_DATA) was accepted and
-    ignored, so F0 71 48 00 69 00 F7 decoded as 'H\\x00i\\x00'; now the spec is refused in one line at its place."""
+    """A finding fixed: an encoding on a string was accepted and ignored (F0 71 48 00 69 00 F7 decoded as
+    'H\\x00i\\x00'); now seven_bit is text of 14-bit characters, and an encoding that makes no sense for text, or
+    seven_bit on text it cannot size, is refused in one line at its place."""
     path = tmp_path / "firmata_text14.yaml"
-    path.write_text(TEXT14, "utf-8")
-    with pytest.raises(SpecErrors, match=r"text\.encoding: `encoding` is how an integer is stored: a string has none"):
+    path.write_text(TEXT14.replace("seven_bit", "sign_magnitude"), "utf-8")
+    with pytest.raises(
+        SpecErrors, match=r"text\.encoding: `encoding` is how an integer is stored: a string takes only"
+    ):
+        load_protocol(str(path))
+    path.write_text(TEXT14.replace("size: rest", "size: 3"), "utf-8")
+    with pytest.raises(SpecErrors, match=r"text\.encoding: size 3: text of 14-bit characters is two bytes a"):
+        load_protocol(str(path))
+    path.write_text(TEXT14.replace("type: string, size: rest", "type: cstring"), "utf-8")
+    with pytest.raises(SpecErrors, match=r"text\.encoding: encoding seven_bit on text needs `size: rest`"):
         load_protocol(str(path))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: text of 14-bit characters (Firmata's STRING_DATA and REPORT_FIRMWARE's name: each "
-    "character as two 7-bit bytes, low first). `encoding: seven_bit` is for integers; a `string` takes no "
-    "encoding, so the spec gives such text as a group of 14-bit numbers (`char14`) and a user joins them",
-)
 def test_text_of_14_bit_characters(tmp_path: Path) -> None:
     path = tmp_path / "firmata_text14.yaml"
     path.write_text(TEXT14, "utf-8")
     module = generate_and_import(path, tmp_path / "out", "firmata_text14")
     message = module.decode(bytes.fromhex("f0 71 48 00 69 00 f7"), module.Direction.RESPONSE)
     assert message.text == "Hi"
+    assert module.encode(module.StringDataResponse(text="é\u3fff")) == bytes.fromhex("f0 71 69 01 7f 7f f7")
+    with pytest.raises(EncodeError, match=r"text: character 0 \(.*, 0x1f600\) is not a 14-bit character"):
+        module.encode(module.StringDataResponse(text="\U0001f600"))
+    with pytest.raises(DecodeError, match="text is not text of 14-bit characters: 3 bytes: an odd count"):
+        module.decode(bytes.fromhex("f0 71 48 00 69 f7"), module.Direction.RESPONSE)

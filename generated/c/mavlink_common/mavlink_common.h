@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "0991aed154cfea722dafc7640b8fa21af7c82bf9b11c54c85a1263ebf41ae776"
+#define MAVLINK_COMMON_SPEC_SHA256 "c45e42c9b0a2ff0c6cfe679f56af36c4023f0ce87b5dfc9f9fed14e2c244a636"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "7d97032fd8d9adb2a4dafcae432455ea0e414fd0e8e65b07ab6779aac55ea079"
+#define ROBOCLAW_SPEC_SHA256 "6affcc467e758ad14eb00517e53c6c1be50c53bc4a8397e9339f47ed82a82af9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

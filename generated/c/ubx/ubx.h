@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "75c182e8fd8b6cc4d8ad5315865756f1b84d48dad439e8439a883f351a314a6c"
+#define UBX_SPEC_SHA256 "812c1af45bebf14a55d8656b514ebad13ca4da14839643670c4ecf8455794062"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

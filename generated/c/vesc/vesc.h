@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "7b96755e9045f1340c9d3263d62d9265a0750c94a8188e848203ee55c189d1a3"
+#define VESC_SPEC_SHA256 "335f6ab052c71d124472a428abdc79d2f98ce05eb6daf2d4ec9fdb4929bf2166"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -2651,6 +2651,10 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
       local pad = string.char(f.pad)
       while text:sub(-1) == pad do text = text:sub(1, -2) end
     end
+    if f.seven_bit then -- 14-bit characters, two 7-bit bytes each, low first
+      text = seven_bit_text(text)
+      if text == nil then error(string.format("%s: not text of 14-bit characters", f.name), 0) end
+    end
     tree:add(f.pf, range, text)
     scope[f.name] = text
     return pos + size

@@ -389,7 +389,7 @@ _FIELD_LONG: dict[str, Shape] = {
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str(
         "How the integer is stored: plain two's complement, sign_magnitude (top bit the sign, the rest the size), or "
-        f"{seven_bit.DOC}.",
+        f"{seven_bit.DOC}; {seven_bit.TEXT_DOC}.",
         choices=("plain", "sign_magnitude", seven_bit.NAME),
         default="plain",
         example="sign_magnitude",

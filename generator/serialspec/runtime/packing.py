@@ -5,6 +5,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
+from serialspec.encodings import seven_bit
 from serialspec.runtime.errors import DecodeError, EncodeError, shown
 from serialspec.runtime.message import is_sequence
 
@@ -58,6 +59,24 @@ def encode_text(value: str, name: str, where: str, terminated: bool) -> bytes:
             raise EncodeError(f"{where}: {name} holds a NUL, which would end it early")
         return data + b"\0"
     return data
+
+
+def decode_seven_bit_text(data: bytes, name: str, where: str) -> str:
+    """Text of 14-bit characters, two 7-bit bytes each, low first (`encoding: seven_bit` on a string)."""
+    try:
+        return seven_bit.text_of(data)
+    except ValueError as exc:
+        raise DecodeError(f"{where}: {name} is not text of 14-bit characters: {exc}") from None
+
+
+def encode_seven_bit_text(value: str, name: str, where: str) -> bytes:
+    """The wire bytes of text of 14-bit characters."""
+    if not isinstance(value, str):
+        raise EncodeError(f"{where}: {name} must be text, got {shown(value)}")
+    try:
+        return seven_bit.text_bytes(value)
+    except ValueError as exc:
+        raise EncodeError(f"{where}: {name}: {exc}") from None
 
 
 def unpack_ints(data: bytes, bits: int, count: int, lsb_first: bool, signed: bool) -> tuple[int, ...]:

@@ -447,6 +447,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes in {f.name}", "size_t"))
             case Text():
                 size = f.size if isinstance(f.size, int) else min(room, DEFAULT_MAX_BYTES)
+                if f.seven_bit:  # two wire bytes a character, up to three bytes of UTF-8 each
+                    size = size // 2 * 3
                 macro = cap_macro(ctx, f"{path}_{f.name}", size)
                 text_doc = doc + "; UTF-8, NUL-terminated here"
                 found.append(Member(name, f"char {name}[{macro} + 1u];", text_doc, "char", macro, 1))
@@ -652,6 +654,11 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}memcpy({tgt}, c + o, k);")
                     out.append(f"{pad}{tgt}[k] = '\\0';")
                     out.append(f"{pad}{tgt}_len = k;")
+                    out.append(f"{pad}o += len;")
+                elif isinstance(f, Text) and f.seven_bit:  # 14-bit characters, two 7-bit bytes each, to UTF-8
+                    get = f"{ctx.p}__text14_get({tgt}, sizeof({tgt}), &{tgt}_len, c + o, len)"
+                    out.append(f"{pad}if (!{get}) {{ return {ctx.P}_E_CONTENT; }}")
+                    ctx.helpers.add("text14_get")
                     out.append(f"{pad}o += len;")
                 elif isinstance(f, Text):
                     out.append(f"{pad}if (len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_CAPACITY; }}")
@@ -1076,6 +1083,12 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
             case Bytes():
                 if not isinstance(f.size, int):
                     out.append(f"{pad}if ({tgt}_len > sizeof({tgt})) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+            case Text() if f.seven_bit:  # UTF-8 of 14-bit characters, as many as its size holds
+                out.append(f"{pad}if ({tgt}_len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                wire = f"{ctx.p}__text14_put(NULL, {tgt}, {tgt}_len)"
+                fits = f" != {f.size}u" if isinstance(f.size, int) else " == (size_t)-1"
+                out.append(f"{pad}if ({wire}{fits}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                ctx.helpers.add("text14_put")
             case Text():
                 out.append(f"{pad}if ({tgt}_len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                 if isinstance(f.size, int):
@@ -1220,6 +1233,12 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 extra = " + 1u" if isinstance(f, Text) and f.terminated else ""
                 if isinstance(f.size, str) and f.size != "rest" and f.size not in scope.names:
                     pass  # sized by a field of an outer scope: the derived check made every item agree
+                if isinstance(f, Text) and f.seven_bit:  # checked to be 14-bit characters (check_fields)
+                    wire = f"{ctx.p}__text14_put(NULL, {tgt}, {tgt}_len)"
+                    out.append(f"{pad}if (cap - o < {wire}) {{ return {ctx.P}_E_BUFFER; }}")
+                    out.append(f"{pad}o += {ctx.p}__text14_put(c + o, {tgt}, {tgt}_len); /* {f.name} */")
+                    ctx.helpers.add("text14_put")
+                    continue
                 if isinstance(f, Text) and f.pad is not None:  # the text, then pad bytes up to its size
                     out.append(f"{pad}if (cap - o < {f.size}u) {{ return {ctx.P}_E_BUFFER; }}")
                     out.append(f"{pad}memcpy(c + o, {tgt}, {length}); /* {f.name} */")

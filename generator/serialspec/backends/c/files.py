@@ -30,6 +30,7 @@ from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
 from serialspec.backends.common.frames import layout_codes, layout_index
+from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
     Direction,
@@ -2263,6 +2264,16 @@ static uint{bits}_t {p}__f{bits}bits({real} f)
 #endif
 """
             )
+    if "text14_get" in ctx.helpers:
+        code = seven_bit.C_TEXT_GET.replace("P__", f"{p}__")
+        parts.append(
+            f"#if {P}_ENABLE_DECODE\n/* Text of 14-bit characters (encoding seven_bit) as UTF-8. */\n{code}\n#endif\n"
+        )
+    if "text14_put" in ctx.helpers:
+        code = seven_bit.C_TEXT_PUT.replace("P__", f"{p}__")
+        parts.append(
+            f"#if {P}_ENABLE_ENCODE\n/* UTF-8 text as 14-bit characters (encoding seven_bit). */\n{code}\n#endif\n"
+        )
     if "utf8" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_ENCODE || {P}_ENABLE_DECODE

@@ -143,6 +143,9 @@ class TextKind(Kind[Text]):
     model = Text
 
     def type_name(self, f: Text) -> str:
+        return self.plain_name(f) + (seven_bit.TEXT_NOTE if f.seven_bit else "")
+
+    def plain_name(self, f: Text) -> str:
         if f.size is None:
             return "text, NUL-terminated"
         if f.size == "rest":

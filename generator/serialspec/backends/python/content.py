@@ -605,8 +605,8 @@ class PackageCode:
             if f.pad is not None:
                 self.packing.add("unpad_text")
                 return f"_unpad_text({name}, {f.pad}, {spec_key(f.name)}, {where})"
-            self.packing.add("decode_text")
-            return f"_decode_text({name}, {spec_key(f.name)}, {where})"
+            helper = self.text_decoder(f)
+            return f"{helper}({name}, {spec_key(f.name)}, {where})"
         if not isinstance(f, Scalar):
             return name
         if f.odd_width:  # read as 3 bytes
@@ -787,22 +787,28 @@ class PackageCode:
             return int(scalars[f.count].type.maximum)
         return None
 
+    def text_decoder(self, f: Text) -> str:
+        """The runtime function making a text field's bytes its text (packing.py)."""
+        helper = "decode_seven_bit_text" if f.seven_bit else "decode_text"
+        self.packing.add(helper)
+        return "_" + helper
+
     def decode_text(self, f: Text, body: Block, where: str) -> str:
         value = self.local(f)
-        self.packing.add("decode_text")
+        helper = self.text_decoder(f)
         if f.size is None:
             body.append(Code("stop = buf.find(b'\\0', o, end)", cursor=True))
             body.append(If("stop < 0", (Raise(f"DecodeError({where} + ': {f.name} has no NUL at its end')"),)))
-            body.append(Code(f"{value} = _decode_text(buf[o:stop], {spec_key(f.name)}, {where})", cursor=True))
+            body.append(Code(f"{value} = {helper}(buf[o:stop], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="stop + 1"))
             return value
         if f.size == "rest":
-            body.append(Code(f"{value} = _decode_text(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
+            body.append(Code(f"{value} = {helper}(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="end"))
             return value
         size = f.size if isinstance(f.size, int) else self.local_named(f.size)
         body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
-        body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
+        body.append(Code(f"{value} = {helper}(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
         body.append(Advance(size))
         return value
 
@@ -1039,12 +1045,17 @@ class PackageCode:
         if isinstance(f.size, int) and f.pad is not None:
             self.packing.add("pad_text")
             return f"_pad_text({expr}, {f.size}, {f.pad}, {spec_key(f.name)}, {where})"
-        self.packing.add("encode_text")
-        data = f"_encode_text({expr}, {spec_key(f.name)}, {where}, {f.size is None})"
+        if f.seven_bit:
+            self.packing.add("encode_seven_bit_text")
+            data = f"_encode_seven_bit_text({expr}, {spec_key(f.name)}, {where})"
+        else:
+            self.packing.add("encode_text")
+            data = f"_encode_text({expr}, {spec_key(f.name)}, {where}, {f.size is None})"
         if isinstance(f.size, int):
             local = self.local(f) if obj == "m" else f"{obj}_{f.name}"
             body.append(Code(f"{local} = {data}"))
-            reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({local})}}"
+            what = f"{f.size // 2} characters ({f.size} bytes)" if f.seven_bit else f"{f.size} bytes of UTF-8"
+            reason = f"{f.name} needs {what}, got {{len({local})}}"
             body.append(If(f"len({local}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
             return local
         return data

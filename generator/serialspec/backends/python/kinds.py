@@ -291,6 +291,8 @@ class TextKind(Kind[Text]):
     model = Text
 
     def construct(self, f: Text, parent: str) -> str:
+        if f.seven_bit:  # 14-bit characters: fixed or rest (the spec check refused the rest)
+            return f"SevenBitText({'GreedyBytes' if f.size == 'rest' else f'Bytes({f.size})'})"
         if isinstance(f.size, int) and f.pad is not None:
             return f"PaddedUtf8({f.size}, {f.pad})"
         if f.size is None:
@@ -313,7 +315,9 @@ class TextKind(Kind[Text]):
         return Calls(f"_text({get}, {spec_key(f.name)}, where)", ["_text"], get)
 
     def blank(self, f: Text) -> str:
-        return repr(" " * f.size) if isinstance(f.size, int) and f.pad is None else "''"
+        if isinstance(f.size, int) and f.pad is None:
+            return repr(" " * (f.size // 2 if f.seven_bit else f.size))
+        return "''"
 
 
 class BytesKind(Kind[Bytes]):

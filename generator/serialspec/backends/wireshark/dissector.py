@@ -78,6 +78,10 @@ def emit_dissector(protocol: Protocol) -> str:
         seven_bit_lua=seven_bit.LUA
         if any(isinstance(f, Scalar) and f.seven_bit for m in protocol.messages() for f in _all_fields(m.fields))
         else "",
+        # and its text of 14-bit characters, where a string uses it
+        seven_bit_text_lua=seven_bit.LUA_TEXT
+        if any(isinstance(f, Text) and f.seven_bit for m in protocol.messages() for f in _all_fields(m.fields))
+        else "",
         bit_run_lua=bit_run.LUA
         if any(isinstance(f, Scalar) and f.bit_place for m in protocol.messages() for f in _all_fields(m.fields))
         else "",
@@ -282,6 +286,8 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
             common["signed"] = item.signed
         case Text():
             common.update(kind="text", size=item.size, pad=item.pad)
+            if item.seven_bit:  # 14-bit characters (absent: nil to the engine)
+                common["seven_bit"] = True
         case Bytes():
             common.update(kind="bytes", size=item.size)
         case Group():

@@ -230,6 +230,7 @@ class Text(Common):
 
     size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
     pad: int | None = None
+    seven_bit: bool = False  # `encoding: seven_bit`: 14-bit characters, two 7-bit bytes each (encodings/seven_bit.py)
 
     @property
     def terminated(self) -> bool:

@@ -215,8 +215,11 @@ class FieldResolver(Pass):
         endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
         if kind in SCALARS or bit_run.width(kind):
             return self.scalar(common, spec, path, endian)
-        if spec.get("encoding", "plain") != "plain":  # a string's bytes as 7-bit pairs would decode as NUL-padded text
-            self.error((*path, "encoding"), f"`encoding` is how an integer is stored: a {kind} has none")
+        encoding = spec.get("encoding", "plain")
+        text_encoding = kind in ("string", "cstring") and encoding == seven_bit.NAME
+        if encoding != "plain" and not text_encoding:
+            what = "a string takes only seven_bit (14-bit characters)" if kind == "string" else f"a {kind} has none"
+            self.error((*path, "encoding"), f"`encoding` is how an integer is stored: {what}")
         if kind == "bytes":
             size = spec.get("size")
             if size is None:
@@ -253,12 +256,17 @@ class FieldResolver(Pass):
             if kind == "cstring":
                 if size is not None:
                     self.error((*path, "size"), "a cstring ends at its NUL byte: it takes no `size`")
-                return Text(**common, size=None, pad=None)
+                if text_encoding:
+                    self.error((*path, "encoding"), seven_bit.text_problem(None, False))
+                return Text(**common, size=None, pad=None, seven_bit=False)
             if size is None:
                 raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
             if isinstance(size, str) and size != "rest":
                 self.size_field(size, name, siblings, parent, path)
-            return Text(**common, size=size, pad=self.pad(spec.get("pad"), size, (*path, "pad")))
+            if text_encoding and (why := seven_bit.text_problem(size, "pad" in spec)):
+                self.error((*path, "encoding"), why)
+            pad = self.pad(spec.get("pad"), size, (*path, "pad"))
+            return Text(**common, size=size, pad=pad, seven_bit=text_encoding)
         if kind == "array" and _PACKED.match(str(spec.get("of", ""))) and str(spec["of"]) not in _BYTE_ALIGNED:
             return self.packed(common, spec, path, endian)
         if "bit_order" in spec:

@@ -211,10 +211,11 @@ CASES: dict[str, Case] = {
     "encoding: plain, seven_bit": same(
         {"v": {"type": "i16", "encoding": "plain"}, "t": {"type": "u16", "encoding": "seven_bit"}, "w": "u8"}
     ),
-    # text of 14-bit characters (Firmata's STRING_DATA): fixed-size and rest
+    # text of 14-bit characters (Firmata's STRING_DATA): fixed-size, in a group's items, and rest
     "encoding: seven_bit on a string": same(
         {
             "name": {"type": "string", "size": 4, "encoding": "seven_bit"},
+            "g": {"type": "group", "count": 2, "fields": {"n": {"type": "string", "size": 2, "encoding": "seven_bit"}}},
             "text": {"type": "string", "size": "rest", "encoding": "seven_bit"},
         }
     ),

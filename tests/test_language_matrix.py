@@ -301,7 +301,13 @@ CASES: dict[str, Case] = {
             "elements": {
                 "header": {"role": "header", "value": HEADER},
                 "reserved": {"role": "constant", "value": "00"},
-                "length": {"role": "length", "type": "u16", "endian": "big", "counts": ["code", "checksum"]},
+                "length": {
+                    "role": "length",
+                    "type": "u16",
+                    "endian": "big",
+                    "counts": ["code", "checksum"],
+                    "range": [5, 1000],  # a candidate whose length is outside it is no frame
+                },
                 "code": {"role": "command", "type": "u8"},
                 "content": {"role": "content"},
                 "checksum": {
@@ -322,7 +328,7 @@ CASES: dict[str, Case] = {
             "elements": {
                 "header": {"role": "header", "value": HEADER},
                 "id": {"role": "address", "type": "u8"},
-                "length": {"role": "length", "type": "u8", "adds": 2},
+                "length": {"role": "length", "type": "u8", "adds": 2, "range": [3, 200]},
                 "code": {"role": "command", "type": "u8", "value": {"response": "00"}},
                 "status": {"role": "status", "type": "u8", "flags": "alarms", "directions": ["response"]},
                 "content": {"role": "content"},

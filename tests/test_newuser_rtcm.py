@@ -20,6 +20,7 @@ from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors
 from serialspec.lang.loader import load_text
 from serialspec.lang.resolve import resolve
+from serialspec.runtime.errors import DecodeError
 
 pyrtcm = pytest.importorskip("pyrtcm")
 
@@ -72,6 +73,20 @@ def test_the_standard_s_1005_example(rtcm: ModuleType) -> None:
     assert parsed.identity == "1005" and ours.to_fields() == theirs(parsed)
     assert ours.x == 11141045999 and ours.station_id == 2003
     assert rtcm.encode(ours) == frame
+
+
+def test_a_reserved_bit_set_before_the_length_is_no_frame(rtcm: ModuleType) -> None:
+    """The 6 bits before the 10-bit length must be 0 (the length's `range: [0, 1023]`): decode refuses a frame with
+    one set in one line, and the stream parser looks past it to the frame after it, whatever the reads."""
+    frame = bytes.fromhex("D3 00 13 3E D7 D3 02 02 98 0E DE EF 34 B4 BD 62 AC 09 41 98 6F 33 36 0B 98")
+    bad = frame[:1] + bytes([frame[1] | 0x04]) + frame[2:]
+    with pytest.raises(DecodeError) as refused:
+        rtcm.decode(bad, "request")
+    assert str(refused.value) == "length = 1043 is outside its range 0..1023"
+    stream = bad[:3] + frame
+    for split in range(len(stream) + 1):
+        parser = rtcm.StreamParser(rtcm.Direction.REQUEST)
+        assert [m.station_id for m in parser.feed(stream[:split]) + parser.feed(stream[split:])] == [2003]
 
 
 @settings(max_examples=25, deadline=None)
@@ -220,8 +235,7 @@ def test_a_run_short_of_a_byte_is_one_spec_error() -> None:
     strict=True,
     reason="the gap: a message picked by its 12-bit message number (the payload's first field, a bit field) where "
     "sizes overlap (1033's counted strings beside 1005 and 1006): frames without a command element are told apart by "
-    "size only, and a sub-command selector is whole bytes. (Also left: the length's 6 reserved bits are read as part "
-    "of a u16 length, not checked to be 0: a length element's `range` is not enforced by the frame engines.)",
+    "size only, and a sub-command selector is whole bytes.",
 )
 def test_messages_picked_by_their_message_number() -> None:
     text = (

@@ -15,11 +15,12 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.backends import emitters
+from serialspec.backends.python import files as python_files
 from serialspec.backends.python.memory import imported
 from serialspec.lang.loader import load_text
 from serialspec.lang.model import Message, Protocol
 from serialspec.lang.resolve import resolve
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from strategies import message_fields
 
 SPEC: dict[str, Any] = {
@@ -123,3 +124,46 @@ def test_a_length_outside_the_sizing_fields_range_is_refused(sized: tuple[Protoc
         assert "\n" not in said and f"{counter} = {size} is outside its range {low}..{high}" in said, said
 
     check()
+
+
+def framed_spec(length: dict[str, Any]) -> str:
+    """A frame whose length element has a `range` (CRSF's [2, 62], RTCM 3's 10 bits after 6 reserved zero bits) and
+    one command whose content is any size: only the range, not the content, bounds a candidate's length."""
+    elements = {
+        "header": SPEC["framing"]["elements"]["header"],
+        "length": {"role": "length", **length},
+        "content": {"role": "content"},
+        "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["length", "content"]},
+    }
+    note = {"request": {"unsolicited": True, "fields": {"data": {"type": "bytes", "size": "rest"}}}}
+    return yaml.safe_dump(
+        SPEC | {"protocol": "ranged", "title": "Ranged", "framing": {"elements": elements}, "commands": {"note": note}},
+        sort_keys=False,
+    )
+
+
+@pytest.mark.parametrize(
+    "length",
+    [{"type": "u8", "range": [1, 6]}, {"type": "u16", "endian": "big", "range": [1, 6]}],
+    ids=["u8 (the length-byte engine)", "u16 big (the general engine)"],
+)
+def test_a_frame_whose_length_is_outside_its_range_is_no_frame(length: dict[str, Any]) -> None:
+    """Decode refuses it in one line, the stream parser looks past it at once (it would otherwise wait for the bytes
+    the length claims, the frame after it unread) whatever the reads, and encode refuses a content it cannot count."""
+    protocol = resolve(load_text(framed_spec(length), "ranged.yaml"))
+    files = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+    with imported("ranged", files, "the ranged length test") as package:
+        good = package.encode(package.NoteRequest(data=b"hi"))
+        width = 1 if length["type"] == "u8" else 2
+        bad = b"\xaa" + (9).to_bytes(width, "big") + b"\x01" * 10  # 9: outside 1..6
+        with pytest.raises(DecodeError) as refused:
+            package.decode(bad, "request")
+        assert str(refused.value) == "length = 9 is outside its range 1..6"
+        stream = bad[: 1 + width] + good
+        for split in range(len(stream) + 1):
+            parser = package.StreamParser("request")
+            got = parser.feed(stream[:split]) + parser.feed(stream[split:])
+            assert [m.data for m in got] == [b"hi"], split
+        with pytest.raises(EncodeError) as refused_encode:
+            package.encode(package.NoteRequest(data=b"seven!!"))  # 7 bytes: a length of 7
+        assert str(refused_encode.value) == "request frame: length = 7 is outside its range 1..6"

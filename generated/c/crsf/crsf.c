@@ -403,6 +403,9 @@ static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t
             if (value < 0 || (uint32_t)value > top) {
                 return CRSF_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return CRSF_E_RANGE; /* outside its range */
+            }
             crsf__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -499,8 +502,12 @@ static int crsf__unwrap(const crsf__layout_t *L, const uint8_t *frame, size_t n,
         const crsf__element_t *e = &L->e[k];
         if (e->role == CRSF__ROLE_LENGTH) {
             bytes = CRSF__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = crsf__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return CRSF_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)crsf__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)crsf__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return CRSF_E_LENGTH;
             }
         }
@@ -580,8 +587,12 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
     }
     if (CRSF__LENGTHS || L->length >= 0) {
         const crsf__element_t *e = &L->e[L->length];
-        long counted = (long)crsf__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = crsf__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return CRSF__NONE; /* outside its range */
+        }
         if (content < (long)low || (!CRSF__T(L) && bounded && content > (long)high)) {
             return CRSF__NONE;
         }
@@ -634,7 +645,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
 static const uint8_t crsf__l_request_0_c0[] = {0xc8u};
 static const crsf__element_t crsf__l_request_0_e[] = {
     {CRSF__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, crsf__l_request_0_c0},  /* sync */
-    {CRSF__ROLE_LENGTH, 1u, 0u, 2u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {CRSF__ROLE_LENGTH, 1u, 0u, 2u, 4u, 0u, 0u, 0L, 2UL, 62UL, 0UL, NULL},  /* length */
     {CRSF__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* type */
     {CRSF__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {CRSF__ROLE_CHECKSUM, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -645,7 +656,7 @@ static const crsf__layout_t crsf__l_request_0 = {crsf__l_request_0_e, 5u, 3, 2, 
 static const uint8_t crsf__l_response_0_c0[] = {0xc8u};
 static const crsf__element_t crsf__l_response_0_e[] = {
     {CRSF__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, crsf__l_response_0_c0},  /* sync */
-    {CRSF__ROLE_LENGTH, 1u, 0u, 2u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {CRSF__ROLE_LENGTH, 1u, 0u, 2u, 4u, 0u, 0u, 0L, 2UL, 62UL, 0UL, NULL},  /* length */
     {CRSF__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* type */
     {CRSF__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {CRSF__ROLE_CHECKSUM, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -1014,6 +1025,7 @@ static int crsf__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, ui
     }
     if (f[0u] != 0xc8u) { return CRSF_E_FRAME; } /* sync */
     *code = (uint32_t)f[2u]; /* type */
+    if ((((uint32_t)f[1u]) < 2u || ((uint32_t)f[1u]) > 62u)) { return CRSF_E_RANGE; } /* length: its range */
     if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 2u) + 0) { return CRSF_E_LENGTH; } /* length */
     if (crsf__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return CRSF_E_CHECKSUM; } /* crc */
     *content = f + 3u;
@@ -1032,6 +1044,7 @@ static int crsf__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, u
     }
     if (f[0u] != 0xc8u) { return CRSF_E_FRAME; } /* sync */
     *code = (uint32_t)f[2u]; /* type */
+    if ((((uint32_t)f[1u]) < 2u || ((uint32_t)f[1u]) > 62u)) { return CRSF_E_RANGE; } /* length: its range */
     if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 2u) + 0) { return CRSF_E_LENGTH; } /* length */
     if (crsf__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return CRSF_E_CHECKSUM; } /* crc */
     *content = f + 3u;

@@ -403,6 +403,9 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
             if (value < 0 || (uint32_t)value > top) {
                 return DYNAMIXEL_P2_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return DYNAMIXEL_P2_E_RANGE; /* outside its range */
+            }
             dynamixel_p2__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -499,8 +502,12 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
         const dynamixel_p2__element_t *e = &L->e[k];
         if (e->role == DYNAMIXEL_P2__ROLE_LENGTH) {
             bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = dynamixel_p2__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return DYNAMIXEL_P2_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)dynamixel_p2__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)dynamixel_p2__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return DYNAMIXEL_P2_E_LENGTH;
             }
         }
@@ -580,8 +587,12 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
     }
     if (DYNAMIXEL_P2__LENGTHS || L->length >= 0) {
         const dynamixel_p2__element_t *e = &L->e[L->length];
-        long counted = (long)dynamixel_p2__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = dynamixel_p2__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return DYNAMIXEL_P2__NONE; /* outside its range */
+        }
         if (content < (long)low || (!DYNAMIXEL_P2__T(L) && bounded && content > (long)high)) {
             return DYNAMIXEL_P2__NONE;
         }
@@ -638,7 +649,7 @@ static const dynamixel_p2__element_t dynamixel_p2__l_request_0_e[] = {
     {DYNAMIXEL_P2__ROLE_CONSTANT, 3u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, dynamixel_p2__l_request_0_c0},  /* header */
     {DYNAMIXEL_P2__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, dynamixel_p2__l_request_0_c1},  /* reserved */
     {DYNAMIXEL_P2__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 1u, 0L, 0UL, 252UL, 254UL, NULL},  /* id */
-    {DYNAMIXEL_P2__ROLE_LENGTH, 2u, 0u, 4u, 6u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {DYNAMIXEL_P2__ROLE_LENGTH, 2u, 0u, 4u, 6u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {DYNAMIXEL_P2__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* instruction */
     {DYNAMIXEL_P2__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {DYNAMIXEL_P2__ROLE_CHECKSUM, 2u, 0u, 0u, 5u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -659,7 +670,7 @@ static const dynamixel_p2__element_t dynamixel_p2__l_response_0_e[] = {
     {DYNAMIXEL_P2__ROLE_CONSTANT, 3u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, dynamixel_p2__l_response_0_c0},  /* header */
     {DYNAMIXEL_P2__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, dynamixel_p2__l_response_0_c1},  /* reserved */
     {DYNAMIXEL_P2__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 1u, 0L, 0UL, 252UL, 254UL, NULL},  /* id */
-    {DYNAMIXEL_P2__ROLE_LENGTH, 2u, 0u, 4u, 7u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {DYNAMIXEL_P2__ROLE_LENGTH, 2u, 0u, 4u, 7u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {DYNAMIXEL_P2__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, dynamixel_p2__l_response_0_c4},  /* instruction */
     {DYNAMIXEL_P2__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* error */
     {DYNAMIXEL_P2__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */

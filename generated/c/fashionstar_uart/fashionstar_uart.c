@@ -399,6 +399,9 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
             if (value < 0 || (uint32_t)value > top) {
                 return FASHIONSTAR_UART_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return FASHIONSTAR_UART_E_RANGE; /* outside its range */
+            }
             fashionstar_uart__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -495,8 +498,12 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
         const fashionstar_uart__element_t *e = &L->e[k];
         if (e->role == FASHIONSTAR_UART__ROLE_LENGTH) {
             bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = fashionstar_uart__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return FASHIONSTAR_UART_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)fashionstar_uart__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)fashionstar_uart__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return FASHIONSTAR_UART_E_LENGTH;
             }
         }
@@ -576,8 +583,12 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
     }
     if (FASHIONSTAR_UART__LENGTHS || L->length >= 0) {
         const fashionstar_uart__element_t *e = &L->e[L->length];
-        long counted = (long)fashionstar_uart__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = fashionstar_uart__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return FASHIONSTAR_UART__NONE; /* outside its range */
+        }
         if (content < (long)low || (!FASHIONSTAR_UART__T(L) && bounded && content > (long)high)) {
             return FASHIONSTAR_UART__NONE;
         }
@@ -631,7 +642,7 @@ static const uint8_t fashionstar_uart__l_request_0_c0[] = {0x12u, 0x4cu};
 static const fashionstar_uart__element_t fashionstar_uart__l_request_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, fashionstar_uart__l_request_0_c0},  /* header */
     {FASHIONSTAR_UART__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* cmd_id */
-    {FASHIONSTAR_UART__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {FASHIONSTAR_UART__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
@@ -642,7 +653,7 @@ static const uint8_t fashionstar_uart__l_response_0_c0[] = {0x05u, 0x1cu};
 static const fashionstar_uart__element_t fashionstar_uart__l_response_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, fashionstar_uart__l_response_0_c0},  /* header */
     {FASHIONSTAR_UART__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* cmd_id */
-    {FASHIONSTAR_UART__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {FASHIONSTAR_UART__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };

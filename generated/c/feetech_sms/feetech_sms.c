@@ -399,6 +399,9 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
             if (value < 0 || (uint32_t)value > top) {
                 return FEETECH_SMS_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return FEETECH_SMS_E_RANGE; /* outside its range */
+            }
             feetech_sms__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -495,8 +498,12 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
         const feetech_sms__element_t *e = &L->e[k];
         if (e->role == FEETECH_SMS__ROLE_LENGTH) {
             bytes = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = feetech_sms__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return FEETECH_SMS_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)feetech_sms__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)feetech_sms__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return FEETECH_SMS_E_LENGTH;
             }
         }
@@ -576,8 +583,12 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
     }
     if (FEETECH_SMS__LENGTHS || L->length >= 0) {
         const feetech_sms__element_t *e = &L->e[L->length];
-        long counted = (long)feetech_sms__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = feetech_sms__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return FEETECH_SMS__NONE; /* outside its range */
+        }
         if (content < (long)low || (!FEETECH_SMS__T(L) && bounded && content > (long)high)) {
             return FEETECH_SMS__NONE;
         }
@@ -631,7 +642,7 @@ static const uint8_t feetech_sms__l_request_0_c0[] = {0xffu, 0xffu};
 static const feetech_sms__element_t feetech_sms__l_request_0_e[] = {
     {FEETECH_SMS__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, feetech_sms__l_request_0_c0},  /* header */
     {FEETECH_SMS__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 1u, 0L, 0UL, 253UL, 254UL, NULL},  /* id */
-    {FEETECH_SMS__ROLE_LENGTH, 1u, 0u, 4u, 4u, 0u, 0u, 2L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {FEETECH_SMS__ROLE_LENGTH, 1u, 0u, 4u, 4u, 0u, 0u, 2L, 0UL, 255UL, 0UL, NULL},  /* length */
     {FEETECH_SMS__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* instruction */
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
@@ -643,7 +654,7 @@ static const uint8_t feetech_sms__l_response_0_c0[] = {0xffu, 0xffu};
 static const feetech_sms__element_t feetech_sms__l_response_0_e[] = {
     {FEETECH_SMS__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, feetech_sms__l_response_0_c0},  /* header */
     {FEETECH_SMS__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 1u, 0L, 0UL, 253UL, 254UL, NULL},  /* id */
-    {FEETECH_SMS__ROLE_LENGTH, 1u, 0u, 4u, 4u, 0u, 0u, 2L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {FEETECH_SMS__ROLE_LENGTH, 1u, 0u, 4u, 4u, 0u, 0u, 2L, 0UL, 255UL, 0UL, NULL},  /* length */
     {FEETECH_SMS__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* error */
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */

@@ -403,6 +403,9 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
             if (value < 0 || (uint32_t)value > top) {
                 return HIWONDER_RRC_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return HIWONDER_RRC_E_RANGE; /* outside its range */
+            }
             hiwonder_rrc__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -499,8 +502,12 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
         const hiwonder_rrc__element_t *e = &L->e[k];
         if (e->role == HIWONDER_RRC__ROLE_LENGTH) {
             bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = hiwonder_rrc__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return HIWONDER_RRC_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)hiwonder_rrc__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)hiwonder_rrc__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return HIWONDER_RRC_E_LENGTH;
             }
         }
@@ -580,8 +587,12 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
     }
     if (HIWONDER_RRC__LENGTHS || L->length >= 0) {
         const hiwonder_rrc__element_t *e = &L->e[L->length];
-        long counted = (long)hiwonder_rrc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = hiwonder_rrc__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return HIWONDER_RRC__NONE; /* outside its range */
+        }
         if (content < (long)low || (!HIWONDER_RRC__T(L) && bounded && content > (long)high)) {
             return HIWONDER_RRC__NONE;
         }
@@ -635,7 +646,7 @@ static const uint8_t hiwonder_rrc__l_request_0_c0[] = {0xaau, 0x55u};
 static const hiwonder_rrc__element_t hiwonder_rrc__l_request_0_e[] = {
     {HIWONDER_RRC__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, hiwonder_rrc__l_request_0_c0},  /* header */
     {HIWONDER_RRC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* function */
-    {HIWONDER_RRC__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {HIWONDER_RRC__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
@@ -646,7 +657,7 @@ static const uint8_t hiwonder_rrc__l_response_0_c0[] = {0xaau, 0x55u};
 static const hiwonder_rrc__element_t hiwonder_rrc__l_response_0_e[] = {
     {HIWONDER_RRC__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, hiwonder_rrc__l_response_0_c0},  /* header */
     {HIWONDER_RRC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* function */
-    {HIWONDER_RRC__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {HIWONDER_RRC__ROLE_LENGTH, 1u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };

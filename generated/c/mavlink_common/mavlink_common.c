@@ -449,6 +449,9 @@ static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out,
             if (value < 0 || (uint32_t)value > top) {
                 return MAVLINK_COMMON_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return MAVLINK_COMMON_E_RANGE; /* outside its range */
+            }
             mavlink_common__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -545,8 +548,12 @@ static int mavlink_common__unwrap(const mavlink_common__layout_t *L, const uint8
         const mavlink_common__element_t *e = &L->e[k];
         if (e->role == MAVLINK_COMMON__ROLE_LENGTH) {
             bytes = MAVLINK_COMMON__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = mavlink_common__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return MAVLINK_COMMON_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)mavlink_common__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)mavlink_common__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return MAVLINK_COMMON_E_LENGTH;
             }
         }
@@ -626,8 +633,12 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
     }
     if (MAVLINK_COMMON__LENGTHS || L->length >= 0) {
         const mavlink_common__element_t *e = &L->e[L->length];
-        long counted = (long)mavlink_common__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = mavlink_common__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return MAVLINK_COMMON__NONE; /* outside its range */
+        }
         if (content < (long)low || (!MAVLINK_COMMON__T(L) && bounded && content > (long)high)) {
             return MAVLINK_COMMON__NONE;
         }
@@ -683,7 +694,7 @@ static const uint8_t mavlink_common__l_request_0_c3[] = {0x00u};
 static const uint8_t mavlink_common__l_request_0_c8[] = {0x00u};
 static const mavlink_common__element_t mavlink_common__l_request_0_e[] = {
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_0_c0},  /* stx */
-    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_0_c2},  /* incompat_flags */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_0_c3},  /* compat_flags */
     {MAVLINK_COMMON__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* seq */
@@ -704,7 +715,7 @@ static const uint8_t mavlink_common__l_request_1_c3[] = {0x00u};
 static const uint8_t mavlink_common__l_request_1_c8[] = {0x00u};
 static const mavlink_common__element_t mavlink_common__l_request_1_e[] = {
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_1_c0},  /* stx */
-    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_1_c2},  /* incompat_flags */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_request_1_c3},  /* compat_flags */
     {MAVLINK_COMMON__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* seq */
@@ -724,7 +735,7 @@ static const uint8_t mavlink_common__l_response_0_c3[] = {0x00u};
 static const uint8_t mavlink_common__l_response_0_c8[] = {0x00u};
 static const mavlink_common__element_t mavlink_common__l_response_0_e[] = {
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_0_c0},  /* stx */
-    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_0_c2},  /* incompat_flags */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_0_c3},  /* compat_flags */
     {MAVLINK_COMMON__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* seq */
@@ -745,7 +756,7 @@ static const uint8_t mavlink_common__l_response_1_c3[] = {0x00u};
 static const uint8_t mavlink_common__l_response_1_c8[] = {0x00u};
 static const mavlink_common__element_t mavlink_common__l_response_1_e[] = {
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_1_c0},  /* stx */
-    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {MAVLINK_COMMON__ROLE_LENGTH, 1u, 0u, 9u, 9u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_1_c2},  /* incompat_flags */
     {MAVLINK_COMMON__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, mavlink_common__l_response_1_c3},  /* compat_flags */
     {MAVLINK_COMMON__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* seq */

@@ -461,6 +461,9 @@ static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, siz
             if (value < 0 || (uint32_t)value > top) {
                 return MODBUS_ASCII_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return MODBUS_ASCII_E_RANGE; /* outside its range */
+            }
             modbus_ascii__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -557,8 +560,12 @@ static int modbus_ascii__unwrap(const modbus_ascii__layout_t *L, const uint8_t *
         const modbus_ascii__element_t *e = &L->e[k];
         if (e->role == MODBUS_ASCII__ROLE_LENGTH) {
             bytes = MODBUS_ASCII__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = modbus_ascii__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return MODBUS_ASCII_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)modbus_ascii__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)modbus_ascii__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return MODBUS_ASCII_E_LENGTH;
             }
         }
@@ -638,8 +645,12 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
     }
     if (MODBUS_ASCII__LENGTHS || L->length >= 0) {
         const modbus_ascii__element_t *e = &L->e[L->length];
-        long counted = (long)modbus_ascii__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = modbus_ascii__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return MODBUS_ASCII__NONE; /* outside its range */
+        }
         if (content < (long)low || (!MODBUS_ASCII__T(L) && bounded && content > (long)high)) {
             return MODBUS_ASCII__NONE;
         }

@@ -403,6 +403,9 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
             if (value < 0 || (uint32_t)value > top) {
                 return MODBUS_RTU_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return MODBUS_RTU_E_RANGE; /* outside its range */
+            }
             modbus_rtu__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -499,8 +502,12 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
         const modbus_rtu__element_t *e = &L->e[k];
         if (e->role == MODBUS_RTU__ROLE_LENGTH) {
             bytes = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = modbus_rtu__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return MODBUS_RTU_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)modbus_rtu__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)modbus_rtu__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return MODBUS_RTU_E_LENGTH;
             }
         }
@@ -580,8 +587,12 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
     }
     if (MODBUS_RTU__LENGTHS || L->length >= 0) {
         const modbus_rtu__element_t *e = &L->e[L->length];
-        long counted = (long)modbus_rtu__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = modbus_rtu__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return MODBUS_RTU__NONE; /* outside its range */
+        }
         if (content < (long)low || (!MODBUS_RTU__T(L) && bounded && content > (long)high)) {
             return MODBUS_RTU__NONE;
         }

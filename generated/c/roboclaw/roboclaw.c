@@ -404,6 +404,9 @@ static int roboclaw__wrap(const roboclaw__layout_t *L, uint8_t *out, size_t cap,
             if (value < 0 || (uint32_t)value > top) {
                 return ROBOCLAW_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return ROBOCLAW_E_RANGE; /* outside its range */
+            }
             roboclaw__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -518,8 +521,12 @@ static int roboclaw__unwrap(const roboclaw__layout_t *L, const uint8_t *frame, s
         const roboclaw__element_t *e = &L->e[k];
         if (e->role == ROBOCLAW__ROLE_LENGTH) {
             bytes = ROBOCLAW__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = roboclaw__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return ROBOCLAW_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)roboclaw__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)roboclaw__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return ROBOCLAW_E_LENGTH;
             }
         }
@@ -599,8 +606,12 @@ static long roboclaw__probe(const roboclaw__layout_t *L, roboclaw_direction_t di
     }
     if (ROBOCLAW__LENGTHS || L->length >= 0) {
         const roboclaw__element_t *e = &L->e[L->length];
-        long counted = (long)roboclaw__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = roboclaw__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return ROBOCLAW__NONE; /* outside its range */
+        }
         if (content < (long)low || (!ROBOCLAW__T(L) && bounded && content > (long)high)) {
             return ROBOCLAW__NONE;
         }

@@ -401,6 +401,9 @@ static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             if (value < 0 || (uint32_t)value > top) {
                 return UBX_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return UBX_E_RANGE; /* outside its range */
+            }
             ubx__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -497,8 +500,12 @@ static int ubx__unwrap(const ubx__layout_t *L, const uint8_t *frame, size_t n, u
         const ubx__element_t *e = &L->e[k];
         if (e->role == UBX__ROLE_LENGTH) {
             bytes = UBX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = ubx__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return UBX_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)ubx__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)ubx__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return UBX_E_LENGTH;
             }
         }
@@ -578,8 +585,12 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
     }
     if (UBX__LENGTHS || L->length >= 0) {
         const ubx__element_t *e = &L->e[L->length];
-        long counted = (long)ubx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = ubx__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return UBX__NONE; /* outside its range */
+        }
         if (content < (long)low || (!UBX__T(L) && bounded && content > (long)high)) {
             return UBX__NONE;
         }
@@ -633,7 +644,7 @@ static const uint8_t ubx__l_request_0_c0[] = {0xb5u, 0x62u};
 static const ubx__element_t ubx__l_request_0_e[] = {
     {UBX__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, ubx__l_request_0_c0},  /* sync */
     {UBX__ROLE_COMMAND, 2u, 1u, 0u, 0u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* message */
-    {UBX__ROLE_LENGTH, 2u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {UBX__ROLE_LENGTH, 2u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {UBX__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {UBX__ROLE_CHECKSUM, 2u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
@@ -644,7 +655,7 @@ static const uint8_t ubx__l_response_0_c0[] = {0xb5u, 0x62u};
 static const ubx__element_t ubx__l_response_0_e[] = {
     {UBX__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, ubx__l_response_0_c0},  /* sync */
     {UBX__ROLE_COMMAND, 2u, 1u, 0u, 0u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* message */
-    {UBX__ROLE_LENGTH, 2u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {UBX__ROLE_LENGTH, 2u, 0u, 3u, 3u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {UBX__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {UBX__ROLE_CHECKSUM, 2u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };

@@ -403,6 +403,9 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
             if (value < 0 || (uint32_t)value > top) {
                 return VESC_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return VESC_E_RANGE; /* outside its range */
+            }
             vesc__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -499,8 +502,12 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
         const vesc__element_t *e = &L->e[k];
         if (e->role == VESC__ROLE_LENGTH) {
             bytes = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = vesc__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return VESC_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)vesc__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)vesc__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return VESC_E_LENGTH;
             }
         }
@@ -580,8 +587,12 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
     }
     if (VESC__LENGTHS || L->length >= 0) {
         const vesc__element_t *e = &L->e[L->length];
-        long counted = (long)vesc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        uint32_t length = vesc__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return VESC__NONE; /* outside its range */
+        }
         if (content < (long)low || (!VESC__T(L) && bounded && content > (long)high)) {
             return VESC__NONE;
         }
@@ -635,7 +646,7 @@ static const uint8_t vesc__l_request_0_c0[] = {0x02u};
 static const uint8_t vesc__l_request_0_c5[] = {0x03u};
 static const vesc__element_t vesc__l_request_0_e[] = {
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_0_c0},  /* start */
-    {VESC__ROLE_LENGTH, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {VESC__ROLE_LENGTH, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {VESC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* command */
     {VESC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -648,7 +659,7 @@ static const uint8_t vesc__l_request_1_c0[] = {0x03u};
 static const uint8_t vesc__l_request_1_c5[] = {0x03u};
 static const vesc__element_t vesc__l_request_1_e[] = {
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_1_c0},  /* start */
-    {VESC__ROLE_LENGTH, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {VESC__ROLE_LENGTH, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {VESC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* command */
     {VESC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -661,7 +672,7 @@ static const uint8_t vesc__l_response_0_c0[] = {0x02u};
 static const uint8_t vesc__l_response_0_c5[] = {0x03u};
 static const vesc__element_t vesc__l_response_0_e[] = {
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_0_c0},  /* start */
-    {VESC__ROLE_LENGTH, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {VESC__ROLE_LENGTH, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* length */
     {VESC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* command */
     {VESC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
@@ -674,7 +685,7 @@ static const uint8_t vesc__l_response_1_c0[] = {0x03u};
 static const uint8_t vesc__l_response_1_c5[] = {0x03u};
 static const vesc__element_t vesc__l_response_1_e[] = {
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_1_c0},  /* start */
-    {VESC__ROLE_LENGTH, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* length */
+    {VESC__ROLE_LENGTH, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 65535UL, 0UL, NULL},  /* length */
     {VESC__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* command */
     {VESC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */

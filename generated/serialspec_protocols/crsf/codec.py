@@ -445,7 +445,7 @@ _REQUEST_FRAMES = FrameCodec(
     (
         Layout('request', (
             Element('sync', 'constant', 1, constant=b'\xc8'),
-            Element('length', 'length', 1, span=(2, 4)),
+            Element('length', 'length', 1, limits=(2, 62), span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
             Element('crc', 'checksum', 1, span=(2, 3), checksum=_CHECK_CRC),
@@ -472,6 +472,8 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     if frame[0] != 0xc8:
         raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
     length = frame[1]
+    if not 2 <= length <= 62:
+        raise DecodeError(f"length = {length} is outside its range 2..62")
     if length != n - 2:
         raise DecodeError(f"length says {length} but the frame holds {n - 2}")
     if _CHECK_CRC(frame[2:]) != 0x00:
@@ -500,6 +502,8 @@ def _wrap_request(content: bytes, code: int | None) -> bytes:
     v_length = len(content) + 2
     if not v_length < 256:
         raise EncodeError(f"request frame: length {v_length} does not fit its 1-byte field")
+    if not 2 <= v_length <= 62:
+        raise EncodeError(f"request frame: length = {v_length} is outside its range 2..62")
     frame = _F_LE_1S_U8_U8.pack(b'\xc8', v_length, code) + content
     return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
 
@@ -517,7 +521,7 @@ _RESPONSE_FRAMES = FrameCodec(
     (
         Layout('response', (
             Element('sync', 'constant', 1, constant=b'\xc8'),
-            Element('length', 'length', 1, span=(2, 4)),
+            Element('length', 'length', 1, limits=(2, 62), span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
             Element('crc', 'checksum', 1, span=(2, 3), checksum=_CHECK_CRC),
@@ -544,6 +548,8 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     if frame[0] != 0xc8:
         raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
     length = frame[1]
+    if not 2 <= length <= 62:
+        raise DecodeError(f"length = {length} is outside its range 2..62")
     if length != n - 2:
         raise DecodeError(f"length says {length} but the frame holds {n - 2}")
     if _CHECK_CRC(frame[2:]) != 0x00:
@@ -572,6 +578,8 @@ def _wrap_response(content: bytes, code: int | None) -> bytes:
     v_length = len(content) + 2
     if not v_length < 256:
         raise EncodeError(f"response frame: length {v_length} does not fit its 1-byte field")
+    if not 2 <= v_length <= 62:
+        raise EncodeError(f"response frame: length = {v_length} is outside its range 2..62")
     frame = _F_LE_1S_U8_U8.pack(b'\xc8', v_length, code) + content
     return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
 
@@ -617,6 +625,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame[0] != 0xc8:
             raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
         length = frame[1]
+        if not 2 <= length <= 62:
+            raise DecodeError(f"length = {length} is outside its range 2..62")
         if length != n - 2:
             raise DecodeError(f"length says {length} but the frame holds {n - 2}")
         if _CHECK_CRC(frame[2:]) != 0x00:
@@ -645,6 +655,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if frame[0] != 0xc8:
             raise DecodeError(f"sync is {frame[0:1].hex(' ')}, expected c8")
         length = frame[1]
+        if not 2 <= length <= 62:
+            raise DecodeError(f"length = {length} is outside its range 2..62")
         if length != n - 2:
             raise DecodeError(f"length says {length} but the frame holds {n - 2}")
         if _CHECK_CRC(frame[2:]) != 0x00:

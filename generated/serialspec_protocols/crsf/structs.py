@@ -69,7 +69,7 @@ _REQUEST_FRAMES = FrameCodec(
     (
         Layout('request', (
             Element('sync', 'constant', 1, constant=b'\xc8'),
-            Element('length', 'length', 1, span=(2, 4)),
+            Element('length', 'length', 1, limits=(2, 62), span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
             Element('crc', 'checksum', 1, span=(2, 3), checksum=_CHECK_CRC),
@@ -83,7 +83,7 @@ _RESPONSE_FRAMES = FrameCodec(
     (
         Layout('response', (
             Element('sync', 'constant', 1, constant=b'\xc8'),
-            Element('length', 'length', 1, span=(2, 4)),
+            Element('length', 'length', 1, limits=(2, 62), span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
             Element('crc', 'checksum', 1, span=(2, 3), checksum=_CHECK_CRC),

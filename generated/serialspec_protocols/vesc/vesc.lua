@@ -1530,6 +1530,11 @@ local function plausible(element, value)
   return (value >= element.min and value <= element.max) or value == element.broadcast
 end
 
+-- A length outside its range (`limits`, where it has one): no frame starts there.
+local function outside_limits(element, value)
+  return element.limits ~= nil and (value < element.limits[1] or value > element.limits[2])
+end
+
 -- Whether `frame`, of an untransformed `layout`, has its constants and checksums right (each element's bytes found
 -- from the frame's start before the content, from its end after it).
 local function frame_checks(layout, frame)
@@ -1592,6 +1597,7 @@ local function frame_size(direction, layout, data, pos)
       if available < inner.at + element.size then return false end
       value = unsigned(data:sub(pos + inner.at, pos + inner.at + element.size - 1), element.big)
     end
+    if outside_limits(element, value) then return nil end
     local counted = value - element.adds
     if counted < inner.counted_fixed then return nil end
     local whole, used = plain_prefix(t, data, pos + layout.prefix, inner.uncounted + counted)
@@ -1604,7 +1610,9 @@ local function frame_size(direction, layout, data, pos)
       local offset, first, last = layout.before[index], element.span[1], element.span[2]
       if offset == nil or layout.before[first] == nil or layout.after[last] == nil then return nil end
       if available < offset + element.size then return false end
-      local counted = unsigned(data:sub(pos + offset, pos + offset + element.size - 1), element.big) - element.adds
+      local value = unsigned(data:sub(pos + offset, pos + offset + element.size - 1), element.big)
+      if outside_limits(element, value) then return nil end
+      local counted = value - element.adds
       if counted < 0 then return nil end
       return layout.before[first] + counted + layout.after[last], entry
     end

@@ -863,7 +863,15 @@ FRAME_ELEMENT = Obj(
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
-        "range": RANGE,
+        "range": ListOf(
+            Num(),
+            "Inclusive [min, max] of the value in wire units; checked before encoding. An address, status or value "
+            "outside it, or a length outside it (CRSF: [2, 62]; RTCM 3: [0, 1023], its 6 reserved bits above a "
+            "10-bit length read as one u16 kept 0), makes a candidate no frame: decode refuses it in one line, the "
+            "stream parser looks past it at once (not waiting for the bytes the length claims), the C and the "
+            "Wireshark dissector likewise; encode refuses a frame whose length would be outside it.",
+            length=2,
+        ),
         "broadcast": Int("address: the broadcast value."),
         "sequence": Bool(
             "value: a sequence number the client fills in: 0 in its first request, one more in each request after "

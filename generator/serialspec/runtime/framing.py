@@ -62,6 +62,9 @@ class Element:
     mask: int = 0
     need: tuple[int, int] = (0, 0)  # value (in a variant): (mask, bits) the value must have under the mask
     wire: tuple[tuple[int, int], ...] = ()  # command: (code, code sent) where the layout sends an expression of it
+    # length: the inclusive range its value must lie in (`range:`), None for any value its bytes hold; a candidate
+    # whose length is outside it is no frame, and encode refuses a frame that would need one
+    limits: tuple[int, int] | None = None
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -71,6 +74,13 @@ class Element:
 
     def plausible(self, value: int) -> bool:
         return (self.minimum <= value <= self.maximum or value == self.also) and value & self.need[0] == self.need[1]
+
+    def length_outside(self, value: int) -> str:
+        """Why a length's value is refused ("" when its range, if any, holds it)."""
+        limits = self.limits
+        if limits is None or limits[0] <= value <= limits[1]:
+            return ""
+        return f"{self.name} = {value} is outside its range {limits[0]}..{limits[1]}"
 
 
 @dataclass(frozen=True)
@@ -321,8 +331,7 @@ class Layout:
         t = self.transparency
         for index, element in plan["inner_lengths"]:  # inside the transformed span: the plain bytes
             value = sum(len(part) for part in plain[element.span[0] : element.span[1] + 1]) + element.adds
-            if not 0 <= value < 1 << (8 * element.size):
-                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            _fits(self, element, value)
             plain[index] = element.pack(value)
         for index, element in plan["inner_checksums"]:  # inside the stuffed span: over the bytes before stuffing
             plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
@@ -331,8 +340,7 @@ class Layout:
             wire[first] = t.encode(b"".join(plain[first : last + 1]))
         for index, element in plan["outer_lengths"]:
             value = len(self._wire(plain, wire, *element.span)) + element.adds
-            if not 0 <= value < 1 << (8 * element.size):
-                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            _fits(self, element, value)
             plain[index] = element.pack(value)
         for index, element in plan["outer_checksums"]:
             covered = self._covered(plain, wire, element)
@@ -436,6 +444,9 @@ class Layout:
         for index, element in plan["lengths"]:
             counted = len(self._wire(plain, wire, *element.span)) + element.adds
             value = element.unpack(plain[index])
+            outside = element.length_outside(value)
+            if outside:  # as the stream parser, which sees no frame there
+                raise DecodeError(outside)
             if value != counted:
                 raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
         for index, element in plan["checksums"]:
@@ -480,6 +491,15 @@ def _requested(element: Element, request: Mapping[str, bytes] | None, error: typ
     return b"".join(request[name] for name in element.request)
 
 
+def _fits(layout: Layout, element: Element, value: int) -> None:
+    """EncodeError for a length `value` its field cannot hold or its range refuses."""
+    if not 0 <= value < 1 << (8 * element.size):
+        raise EncodeError(f"{layout.name} frame: length {value} does not fit its {element.size}-byte field")
+    outside = element.length_outside(value)
+    if outside:
+        raise EncodeError(f"{layout.name} frame: {outside}")
+
+
 def _outside(element: Element, value: int) -> str:
     also = f" (or {element.also})" if element.also is not None else ""
     return f"{element.name} = {value} is outside its range {element.minimum}..{element.maximum}{also}"
@@ -514,6 +534,8 @@ def _inner_size(
             return None
         else:
             value = element.unpack(buffer[start + at : start + at + element.size])
+        if element.length_outside(value):
+            return -1
         counted = value - element.adds
         content = counted - counted_fixed  # the length counts the content (lang/passes/framing.py)
         if content < low or (high is not None and content > high):
@@ -783,7 +805,10 @@ class FrameCodec:
         length: tuple[int, Element, int, int] | None = plan["probe_length"]
         if length is not None:
             offset, element, outside, inside_fixed = length
-            counted = element.unpack(buffer[start + offset : start + offset + element.size]) - element.adds
+            counted = element.unpack(buffer[start + offset : start + offset + element.size])
+            if element.limits is not None and not element.limits[0] <= counted <= element.limits[1]:
+                return -1
+            counted -= element.adds
             content = counted - inside_fixed  # wire bytes of the content (stuffed, if it is)
             if content < low or (layout.transparency is None and high is not None and content > high):
                 return -1
@@ -939,6 +964,7 @@ class FrameCodec:
         measured = None  # the length element read in place: offset, stop, byte order, adds, sizes around it
         if length is not None:
             offset, element, outside, inside_fixed = length
+            low_length, high_length = element.limits or (0, (1 << 8 * element.size) - 1)
             measured = (offset, offset + element.size, element.endian, element.adds, outside, inside_fixed)
         trailer = layout.trailer if layout.trailer and layout.transparency is not None else b""
         terminated = bool(layout.trailer)
@@ -972,7 +998,10 @@ class FrameCodec:
             low, high = content_sizes.get(code, (0, None))
             if measured is not None:
                 offset, stop, endian, adds, outside, inside_fixed = measured
-                counted = int.from_bytes(buffer[start + offset : start + stop], endian) - adds
+                counted = int.from_bytes(buffer[start + offset : start + stop], endian)
+                if not low_length <= counted <= high_length:
+                    return -1
+                counted -= adds
                 content = counted - inside_fixed
                 if content < low or (bounded and high is not None and content > high):
                     return -1

@@ -322,6 +322,9 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
             if (value < 0 || (uint32_t)value > top) {
                 return PFX_E_LENGTH;
             }
+            if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                return PFX_E_RANGE; /* outside its range */
+            }
             pfx__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
         }
     }
@@ -419,8 +422,12 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
         const pfx__element_t *e = &L->e[k];
         if (e->role == PFX__ROLE_LENGTH) {
             bytes = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            uint32_t length = pfx__get(bytes, e->size, e->big);
+            if (length < e->minimum || length > e->maximum) {
+                return PFX_E_RANGE; /* outside its range: as the parser, which sees no frame there */
+            }
             (void)pfx__range(L, &w, frame, body, e->first, e->last, &sz);
-            if ((int32_t)pfx__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+            if ((int32_t)length != (int32_t)sz + e->adds) {
                 return PFX_E_LENGTH;
             }
         }
@@ -500,8 +507,12 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
     }
     if (PFX__LENGTHS || L->length >= 0) {
         const pfx__element_t *e = &L->e[L->length];
-        /*@inner_size@*/long counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        /*@inner_size@*/uint32_t length = pfx__get(b + L->length_off, e->size, e->big);
+        long counted = (long)length - (long)e->adds;
         long content = counted - (long)L->counted;
+        if (length < e->minimum || length > e->maximum) {
+            return PFX__NONE; /* outside its range */
+        }
         if (content < (long)low || (!PFX__T(L) && bounded && content > (long)high)) {
             return PFX__NONE;
         }
@@ -598,6 +609,9 @@ INNER_LENGTHS = r"""/* lengths inside the span count its plain bytes: made befor
                 if (value < 0 || (uint32_t)value > top) {
                     return PFX_E_LENGTH;
                 }
+                if ((uint32_t)value < e->minimum || (uint32_t)value > e->maximum) {
+                    return PFX_E_RANGE; /* outside its range */
+                }
                 pfx__put(span + w.ps[k], e->size, e->big, (uint32_t)value);
             }
         }
@@ -653,6 +667,7 @@ static long pfx__inner_size(const pfx__layout_t *L, const pfx__element_t *e, con
 {
     uint8_t value[4];
     size_t at = 0u, fixed = 0u;
+    uint32_t length;
     long counted, content, used;
     uint8_t k;
     for (k = L->t_first; k <= L->t_last; k++) {
@@ -666,10 +681,14 @@ static long pfx__inner_size(const pfx__layout_t *L, const pfx__element_t *e, con
         if (used < 0) {
             return used;
         }
-        counted = (long)pfx__get(value, e->size, e->big) - (long)e->adds;
+        length = pfx__get(value, e->size, e->big);
     } else {
-        counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        length = pfx__get(b + L->length_off, e->size, e->big);
     }
+    if (length < e->minimum || length > e->maximum) {
+        return PFX__NONE; /* outside its range */
+    }
+    counted = (long)length - (long)e->adds;
     content = counted - (long)L->counted;
     if (content < (long)low || (bounded && content > (long)high)) {
         return PFX__NONE;

@@ -29,7 +29,7 @@ from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, wi
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
-from serialspec.backends.common.frames import layout_codes, layout_index
+from serialspec.backends.common.frames import layout_codes, layout_index, length_limits
 from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -389,6 +389,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         if e.role == "checksum" and e.checksum is not None and e.checksum.skips:  # the elements left out, a bit each
             minimum = sum(1 << names.index(name) for name in e.checksum.skips)
         maximum = int(e.maximum) if value else 0
+        if e.role == "length":  # the values its range allows (every one its size holds, without a range)
+            minimum, maximum = length_limits(e) or (0, (1 << (8 * (e.size or 1))) - 1)
         also = e.broadcast if value and e.broadcast is not None else None
         # (a checksum's has_also: 1 when it takes in the request's bytes first, `from_request`)
         taken = e.checksum is not None and bool(e.checksum.from_request)
@@ -815,6 +817,11 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
         if e.role == "length":
             a, b = names.index(e.counts[0]), names.index(e.counts[1])
             value = _wire_value(start[i], sizes[i], e.endian == ">")
+            limits = length_limits(e)
+            if limits is not None:  # as the stream parser, which sees no frame there (it checked it when sized)
+                low, high = limits
+                refused = f"({value}) < {low}u || ({value}) > {high}u" if low else f"({value}) > {high}u"
+                lines.append(f"    if ({skip}({refused})) {{ return {P}_E_RANGE; }} /* {e.name}: its range */")
             lines.append(
                 f"    if ({skip}(int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
                 f"/* {e.name} */"

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from serialspec.backends.c import parser_api
 from serialspec.backends.c.emit import Ctx
+from serialspec.backends.common.frames import length_limits
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Protocol
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
@@ -118,6 +119,11 @@ def size_function(ctx: Ctx, direction: Direction, layout: FrameLayout) -> str:
                     cond = f"({cond}) && v != {e.broadcast}u"
                 lines.append(f"    {{ uint32_t v = {value}; if ({cond}) {{ return 0u; }} }} /* {e.name} */")
         offset += size
+    limits = None if layout.length is None else length_limits(layout.length)
+    if limits is not None:  # a length byte outside its range: no frame
+        at = f"f[{layout.length_offset}u]"
+        refused = f"{at} < {limits[0]}u || {at} > {limits[1]}u" if limits[0] else f"{at} > {limits[1]}u"
+        lines.append(f"    if ({refused}) {{ return 0u; }} /* {length}: its range */")
     lines += [
         f"    if (!{p}__bounds({P}_{direction.name}, {code}, &low, &high, &bounded)) {{ return 0u; }}",
         f"    content = (long)f[{layout.length_offset}u] - {layout.length_adds}L; /* {length} */",

@@ -54,7 +54,16 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         flag=layout.index(element.present_if[0]) if element.present_if[0] else -1,
         mask=element.present_if[1],
         wire=element.wire,
+        limits=length_limits(element) if kind == "length" else None,
     )
+
+
+def length_limits(element: FrameElement) -> tuple[int, int] | None:
+    """A length element's `range` where it is narrower than its type's: (low, high); None otherwise."""
+    assert element.type is not None
+    if (element.minimum, element.maximum) == (element.type.minimum, element.type.maximum):
+        return None
+    return int(element.minimum), int(element.maximum)
 
 
 def runtime_layout(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> Layout:

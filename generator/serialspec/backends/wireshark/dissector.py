@@ -182,6 +182,8 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
         if element.role == "length":
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["adds"] = element.adds
+            if runtime.limits is not None:  # its range: a candidate whose length is outside it is no frame
+                item["limits"] = list(runtime.limits)
         if element.checksum is not None:
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["checksum"] = _checksum(element.checksum)

@@ -111,8 +111,14 @@ def decode_lines(
         if element.kind != "length":
             continue
         counted = positions.counted(*element.span, element.adds)
+        body.append(f"length = {positions.read(index)}")
+        if element.limits is not None:  # as the stream parser, which sees no frame there
+            low, high = element.limits
+            body += [
+                f"if not {low} <= length <= {high}:" if low else f"if length > {high}:",
+                f'    raise DecodeError(f"{element.name} = {{length}} is outside its range {low}..{high}")',
+            ]
         body += [
-            f"length = {positions.read(index)}",
             f"if length != {counted}:",
             f'    raise DecodeError(f"{element.name} says {{length}} but the frame holds {{{counted}}}")',
         ]

@@ -9,7 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Protocol as Interface
 
-from serialspec.backends.common.frames import layout_index, optional_elements
+from serialspec.backends.common.frames import layout_index, length_limits, optional_elements
 from serialspec.backends.python.checksum_code import (
     checksum_expression,
     checksum_lines,
@@ -189,6 +189,15 @@ def wrap_parts(
                 f'{element.size}-byte field")',
             )
         )
+        if element.limits is not None:
+            low, high = element.limits
+            fits.append(
+                (
+                    f"{low} <= {name} <= {high}",
+                    f'raise EncodeError(f"{layout.name} frame: {element.name} = {{{name}}} is outside its range '
+                    f'{low}..{high}")',
+                )
+            )
     frame = " + ".join(p for p in (packed(list(range(first))), wire) if p)
     rest = closing_lines(layout, frame, checks, packed)
     return LayoutEncoding(prelude, fits, rest)
@@ -542,8 +551,8 @@ def head_struct(
         if element.role == "command":
             args.append(code)
         elif element.role == "length":
-            if isinstance(length, int) and length > element.type.maximum:
-                return None
+            if isinstance(length, int) and not element.minimum <= length <= element.maximum:
+                return None  # (its range refused by length_byte_lines)
             args.append(str(length))
         else:  # address, status: the message's frame values, in element order
             args.append(next(remaining))
@@ -583,6 +592,11 @@ def length_byte_lines(
     size = f"n - {layout.length_adds}" if layout.length_adds else "n"
     error = f"EncodeError(f'content of {{{size}}} bytes does not fit the length field')"
     body.append(If(f"n > {int(length.type.maximum)}", (Raise(error),)))
+    limits = length_limits(length)
+    if limits is not None:
+        low, high = limits
+        shown = f"{layout.direction.value} frame: {length.name} = {{n}} is outside its range {low}..{high}"
+        body.append(If(f"not {low} <= n <= {high}", (Raise(f'EncodeError(f"{shown}")'),)))
     head = head_struct(package, layout, "<", code, "n", values)
     assert head is not None  # little-endian and a length computed at run time: always possible
     head_format, head_args = head

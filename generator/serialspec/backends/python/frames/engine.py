@@ -80,6 +80,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
         args += [f"minimum={e.minimum}", f"maximum={e.maximum}"]
         if e.also is not None:
             args.append(f"also={e.also}")
+    if e.limits is not None:
+        args.append(f"limits={e.limits}")
     if e.wire:
         pairs = ", ".join(f"({code:#04x}, {sent:#04x})" for code, sent in e.wire)
         args.append(f"wire=({pairs}{',' if len(e.wire) == 1 else ''})")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from serialspec.backends.common.frames import length_limits
 from serialspec.backends.python.checksum_code import checksum_lines, checksum_setup
 from serialspec.backends.python.dispatch import (
     direction_dispatch,
@@ -315,6 +316,10 @@ def value_ranges(layout: FrameLayout, byte_order: str) -> str:
         for e in layout.value_elements
         if e.type is not None and not e.type.is_float and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
     ]
+    length = layout.length
+    limits = None if length is None else length_limits(length)
+    if length is not None and limits is not None:  # a length byte outside its range: no frame either
+        ranges.append(f"({layout.length_offset}, 1, {byte_order!r}, False, {limits[0]}, {limits[1]}, None)")
     return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
 
 

@@ -340,7 +340,7 @@ def test_the_c_and_the_dissector_read_tmc2209(tmp_path: Path) -> None:
 
 
 def test_ifcnt_counts_the_writes_taken_modulo_256(tmc: ModuleType) -> None:
-    """`steps: [ifcnt]` with `modulo: {ifcnt: 256}` on every write (a device key added for this spec): IFCNT counts
+    """`increments: [ifcnt]` with `modulo: {ifcnt: 256}` on every write (a device key added for this spec): IFCNT counts
     the writes, wraps past 255, and reads do not count."""
     sim = importlib.import_module("tmc2209.simulator").Tmc2209Simulator(ids=[0])
     sync = tmc.SyncBits(nibble=5, reserved=5)
@@ -360,12 +360,12 @@ def test_ifcnt_counts_the_writes_taken_modulo_256(tmc: ModuleType) -> None:
     assert ifcnt() == 0
 
 
-def test_steps_names_a_state_variable_or_memory_entry(tmp_path: Path) -> None:
+def test_increments_names_a_state_variable_or_memory_entry(tmp_path: Path) -> None:
     from serialspec.lang import SpecErrors, load_protocol
 
     text = SPEC.read_text("utf-8").replace(
-        "write_tpowerdown: {writes: [tpowerdown], steps: [ifcnt]",
-        "write_tpowerdown: {writes: [tpowerdown], steps: [ifcn]",
+        "write_tpowerdown: {writes: [tpowerdown], increments: [ifcnt]",
+        "write_tpowerdown: {writes: [tpowerdown], increments: [ifcn]",
     )
     spec = tmp_path / "tmc2209.yaml"
     spec.write_text(text, "utf-8")
@@ -373,7 +373,7 @@ def test_steps_names_a_state_variable_or_memory_entry(tmp_path: Path) -> None:
         load_protocol(str(spec), "tmc2209.yaml")
     lines = str(caught.value).splitlines()
     assert len(lines) == 1, lines
-    assert "device.commands.write_tpowerdown.steps: unknown state variable 'ifcn'" in lines[0]
+    assert "device.commands.write_tpowerdown.increments: unknown state variable 'ifcn'" in lines[0]
 
 
 def test_serialspec_scan_finds_the_drivers_of_the_sim(sim_path: str, capsys: pytest.CaptureFixture[str]) -> None:

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "10d964990c8b734a58240272ea1b0cfd32f952cf68a4ff2b54d9ae8536dcaa51"
+#define CRSF_SPEC_SHA256 "7dacf366bfacf83ca574a92777ca10419bb72fca52e20fe0786048fbc4187d4f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

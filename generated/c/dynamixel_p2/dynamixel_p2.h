@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "78962b576abb6e4c3a1220762434570186a931060d5bd8b044c1858557ae7a6e"
+#define DYNAMIXEL_P2_SPEC_SHA256 "b90fd12a1237c157dc848880b4df59a27f16ecfcceb54af902e9bf6ce648da6f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "c4124573153671c76dd57893a1259753d5328d3e49ec99e9a850a18fce9af767"
+#define FEETECH_SMS_SPEC_SHA256 "6c8d762517bf78ee4f24cce83bb9a94325827b271dbb7f7ba5feeef63346d03b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

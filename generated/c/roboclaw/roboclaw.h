@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "6affcc467e758ad14eb00517e53c6c1be50c53bc4a8397e9339f47ed82a82af9"
+#define ROBOCLAW_SPEC_SHA256 "dc99ab541ff11db57e9f184522c6f145f58efb6c956239e0cf721362518146e6"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "812c1af45bebf14a55d8656b514ebad13ca4da14839643670c4ecf8455794062"
+#define UBX_SPEC_SHA256 "a269e841461634141764912f2a3576ada17bda17ebc16c28b4216e1e9d1e2762"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "335f6ab052c71d124472a428abdc79d2f98ce05eb6daf2d4ec9fdb4929bf2166"
+#define VESC_SPEC_SHA256 "a0af0d424cf1b3457acf1ce3fed2444f2995686088f5e95a6b97eec5582db7bc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

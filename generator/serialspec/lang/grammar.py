@@ -1237,10 +1237,10 @@ DEVICE_COMMAND = Obj(
             description="The device moves a state variable to a target, over a duration or at a speed.",
         ),
         "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
-        "steps": ListOf(
+        "increments": ListOf(
             Str(),
             "State variables or memory entries the command adds 1 to each time the device carries out a request "
-            "that is not refused: a count of the writes taken (the TMC2209's IFCNT: `steps: [ifcnt]`, with "
+            "that is not refused: a count of the writes taken (the TMC2209's IFCNT: `increments: [ifcnt]`, with "
             "`modulo: {ifcnt: 256}` for a count that wraps past 255).",
             example=["ifcnt"],
         ),

@@ -43,7 +43,7 @@ BEHAVIOUR_ARGUMENTS = (
     "buffered",
     "commits",
     "stops",
-    "steps",
+    "increments",
     "wraps",
     "modulo",
     "restores",

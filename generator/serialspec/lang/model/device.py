@@ -87,7 +87,7 @@ class Behaviour:
     space_writes: dict[str, SpaceAccess] = field(default_factory=dict)  # request field -> run written
     keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
-    steps: tuple[str, ...] = ()  # state variables (or memory entries) 1 is added to when a request is carried out
+    increments: tuple[str, ...] = ()  # state variables (or memory entries) 1 is added to when a request is carried out
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values (a reboot's RAM)

@@ -791,7 +791,7 @@ class DevicePass(Pass):
                 carried.append(str(name))
         return {
             "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
-            "steps": tuple(known(str(n), (*path, "steps")) for n in item.get("steps") or ()),
+            "increments": tuple(known(str(n), (*path, "increments")) for n in item.get("increments") or ()),
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
             "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
             "restores": restores,

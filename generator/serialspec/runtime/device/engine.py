@@ -106,7 +106,7 @@ class CommandSpec:
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
-    steps: tuple[str, ...] = ()  # state variables (or memory entries) 1 is added to when the request is carried out
+    increments: tuple[str, ...] = ()  # state variables (or memory entries) 1 is added to per request carried out
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
@@ -714,7 +714,7 @@ class Engine(FaultInjection):
             device.set(state, value)
         for state in command.stops:
             device.set(state, device.get(state))
-        for state in command.steps if not refused else ():
+        for state in command.increments if not refused else ():
             device.set(state, device.get(state) + 1)
         for state, period in command.wraps.items():
             device.set(state, math.fmod(device.get(state), period))

@@ -228,13 +228,13 @@ typedef struct {
 
 /* Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE) (request).  */
 typedef struct {
-    char mode[CRSF_FLIGHT_MODE_REQUEST_MODE_MAX + 1u];  /* The flight mode, NUL-terminated.; UTF-8, NUL-terminated here */
+    char mode[CRSF_FLIGHT_MODE_REQUEST_MODE_MAX + 1u];  /* The flight mode, NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t mode_len;  /* bytes of text in mode */
 } crsf_flight_mode_request_t;
 
 /* Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE) (response).  */
 typedef struct {
-    char mode[CRSF_FLIGHT_MODE_RESPONSE_MODE_MAX + 1u];  /* The flight mode, NUL-terminated.; UTF-8, NUL-terminated here */
+    char mode[CRSF_FLIGHT_MODE_RESPONSE_MODE_MAX + 1u];  /* The flight mode, NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t mode_len;  /* bytes of text in mode */
 } crsf_flight_mode_response_t;
 
@@ -248,7 +248,7 @@ typedef struct {
 typedef struct {
     uint8_t destination;  /* Extended header: the address of the device the frame is for (0x00 for every device).; range 0..239; enum address */
     uint8_t origin;  /* Extended header: the address of the device that sent the frame.; range 0..239; enum address */
-    char name[CRSF_DEVICE_INFO_RESPONSE_NAME_MAX + 1u];  /* The device's name, NUL-terminated.; UTF-8, NUL-terminated here */
+    char name[CRSF_DEVICE_INFO_RESPONSE_NAME_MAX + 1u];  /* The device's name, NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t name_len;  /* bytes of text in name */
     uint32_t serial_number;  /* Serial number (ExpressLRS: the bytes 'ELRS').; range 0..4.29497e+09 */
     uint32_t hardware_id;  /* Hardware version.; range 0..4.29497e+09 */

@@ -278,7 +278,7 @@ typedef struct {
     int16_t param_index;  /* The parameter's index, or -1 to name it by param_id.; range -32768..32767 */
     uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system).; range 0..255 */
     uint8_t target_component;  /* Component id of the component the message is for (0 for every component).; range 0..255 */
-    char param_id[MAVLINK_COMMON_PARAM_REQUEST_READ_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used).; UTF-8, NUL-terminated here */
+    char param_id[MAVLINK_COMMON_PARAM_REQUEST_READ_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
@@ -292,7 +292,7 @@ typedef struct {
     float param_value;  /* The parameter's value (integer parameters are sent as the float of the same value). */
     uint16_t param_count;  /* How many parameters the component has.; range 0..65535 */
     uint16_t param_index;  /* The parameter's index (65535 when not known, e.g. after PARAM_SET).; range 0..65535 */
-    char param_id[MAVLINK_COMMON_PARAM_VALUE_RESPONSE_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used).; UTF-8, NUL-terminated here */
+    char param_id[MAVLINK_COMMON_PARAM_VALUE_RESPONSE_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
     uint8_t param_type;  /* The type of the parameter's value.; range 0..255; enum mav_param_type */
     bool has_signature;  /* signature sent (encode: send it) */
@@ -307,7 +307,7 @@ typedef struct {
     float param_value;  /* The parameter's value (integer parameters are sent as the float of the same value). */
     uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system).; range 0..255 */
     uint8_t target_component;  /* Component id of the component the message is for (0 for every component).; range 0..255 */
-    char param_id[MAVLINK_COMMON_PARAM_SET_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used).; UTF-8, NUL-terminated here */
+    char param_id[MAVLINK_COMMON_PARAM_SET_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
     uint8_t param_type;  /* The type of the parameter's value.; range 0..255; enum mav_param_type */
     bool has_signature;  /* signature sent (encode: send it) */

@@ -249,7 +249,7 @@ typedef struct {
 
 /* Read firmware version (response).  */
 typedef struct {
-    char version[ROBOCLAW_READ_VERSION_RESPONSE_VERSION_MAX + 1u];  /* The firmware version text, ended by a NUL byte (at most 48 bytes).; UTF-8, NUL-terminated here */
+    char version[ROBOCLAW_READ_VERSION_RESPONSE_VERSION_MAX + 1u];  /* The firmware version text, ended by a NUL byte (at most 48 bytes). (in C: UTF-8, NUL-terminated) */
     size_t version_len;  /* bytes of text in version */
 } roboclaw_read_version_response_t;
 

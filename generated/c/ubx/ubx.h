@@ -149,7 +149,7 @@ typedef enum {
 
 /* One item of extensions. */
 typedef struct {
-    char extension[UBX_MON_VER_RESPONSE_EXTENSIONS_EXTENSION_MAX + 1u];  /* One item of extended version information, NUL-padded.; UTF-8, NUL-terminated here */
+    char extension[UBX_MON_VER_RESPONSE_EXTENSIONS_EXTENSION_MAX + 1u];  /* One item of extended version information, NUL-padded. (in C: UTF-8, NUL-terminated) */
     size_t extension_len;  /* bytes of text in extension */
 } ubx_mon_ver_response_extensions_item_t;
 
@@ -273,9 +273,9 @@ typedef struct {
 
 /* MON-VER, receiver and software version (response).  */
 typedef struct {
-    char sw_version[UBX_MON_VER_RESPONSE_SW_VERSION_MAX + 1u];  /* The software version (ROM BASE 0x118B2060), NUL-padded.; UTF-8, NUL-terminated here */
+    char sw_version[UBX_MON_VER_RESPONSE_SW_VERSION_MAX + 1u];  /* The software version (ROM BASE 0x118B2060), NUL-padded. (in C: UTF-8, NUL-terminated) */
     size_t sw_version_len;  /* bytes of text in sw_version */
-    char hw_version[UBX_MON_VER_RESPONSE_HW_VERSION_MAX + 1u];  /* The hardware version (00080000 for u-blox 8), NUL-padded.; UTF-8, NUL-terminated here */
+    char hw_version[UBX_MON_VER_RESPONSE_HW_VERSION_MAX + 1u];  /* The hardware version (00080000 for u-blox 8), NUL-padded. (in C: UTF-8, NUL-terminated) */
     size_t hw_version_len;  /* bytes of text in hw_version */
     ubx_mon_ver_response_extensions_item_t extensions[UBX_MON_VER_RESPONSE_EXTENSIONS_MAX];  /* Extended version information, 30 bytes each (FWVER=, PROTVER=, MOD=, GNSS names). */
     size_t extensions_count;  /* items in extensions */

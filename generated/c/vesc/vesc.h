@@ -168,7 +168,7 @@ typedef struct {
 typedef struct {
     uint8_t major;  /* Firmware major version.; range 0..255 */
     uint8_t minor;  /* Firmware minor version.; range 0..255 */
-    char hw_name[VESC_FW_VERSION_RESPONSE_HW_NAME_MAX + 1u];  /* Hardware name (HW_NAME), NUL-terminated.; UTF-8, NUL-terminated here */
+    char hw_name[VESC_FW_VERSION_RESPONSE_HW_NAME_MAX + 1u];  /* Hardware name (HW_NAME), NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t hw_name_len;  /* bytes of text in hw_name */
     uint8_t uuid[12];  /* The STM32's 96-bit unique id (plus 1 for a second motor). */
     uint8_t pairing_done;  /* 1 once NRF pairing is done.; range 0..255 */
@@ -179,7 +179,7 @@ typedef struct {
     uint8_t qml_hw;  /* QML UI from the hardware: 0 none, 1 yes, 2 fullscreen.; range 0..255 */
     uint8_t qml_app;  /* QML UI from the app: 0 none, else its flags.; range 0..255 */
     uint8_t nrf_flags;  /* NRF radio flags.; range 0..255 */
-    char fw_name[VESC_FW_VERSION_RESPONSE_FW_NAME_MAX + 1u];  /* Firmware name (FW_NAME), NUL-terminated.; UTF-8, NUL-terminated here */
+    char fw_name[VESC_FW_VERSION_RESPONSE_FW_NAME_MAX + 1u];  /* Firmware name (FW_NAME), NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t fw_name_len;  /* bytes of text in fw_name */
     uint32_t hw_crc;  /* CRC of the hardware configuration (main_calc_hw_crc).; range 0..4.29497e+09 */
 } vesc_fw_version_response_t;
@@ -249,7 +249,7 @@ typedef struct {
 
 /* COMM_PRINT (response).  */
 typedef struct {
-    char text[VESC_PRINT_RESPONSE_TEXT_MAX + 1u];  /* The text, not NUL-terminated.; UTF-8, NUL-terminated here */
+    char text[VESC_PRINT_RESPONSE_TEXT_MAX + 1u];  /* The text, not NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t text_len;  /* bytes of text in text */
 } vesc_print_response_t;
 

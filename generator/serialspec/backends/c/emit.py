@@ -450,7 +450,7 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                 if f.seven_bit:  # two wire bytes a character, up to three bytes of UTF-8 each
                     size = size // 2 * 3
                 macro = cap_macro(ctx, f"{path}_{f.name}", size)
-                text_doc = doc + "; UTF-8, NUL-terminated here"
+                text_doc = f"{doc} (in C: UTF-8, NUL-terminated)"  # the spec's description, then how C holds it
                 found.append(Member(name, f"char {name}[{macro} + 1u];", text_doc, "char", macro, 1))
                 found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes of text in {f.name}", "size_t"))
             case Group():

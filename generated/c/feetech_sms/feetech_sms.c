@@ -1828,6 +1828,10 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
         return 0u;
     }
     for (i = 1u; i + hl <= size; i++) {
+        if (data[i + hl - 1u] != 0xffu) { /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }
         if (data[i] == h[0] && feetech_sms__same(data + i, h, hl)) {
             return 0u;
         }

@@ -4635,6 +4635,10 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
         return 0u;
     }
     for (i = 1u; i + hl <= size; i++) {
+        if (data[i + hl - 1u] != 0x55u && data[i + hl - 1u] != 0xaau) { /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }
         if (data[i] == h[0] && hiwonder_rrc__same(data + i, h, hl)) {
             return 0u;
         }

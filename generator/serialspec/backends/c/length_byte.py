@@ -181,6 +181,15 @@ def parser(ctx: Ctx) -> str:
         starts = f"n >= {hl} && {p}__same(b + end - {hl}, {header}, {hl})"
     keep = max(len(layout.header) for layout in layouts.values()) - 1
     hl_feed = hl.replace("p->dir", "parser->dir")
+    skip = ""  # one header: a byte that is none of its bytes ends no header that covers it, so none starts before it
+    if len(heads) == 1:
+        (head,) = heads
+        outside = " && ".join(f"data[i + hl - 1u] != 0x{c:02x}u" for c in sorted(set(head)))
+        skip = f"""
+        if ({outside}) {{ /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }}"""
     small = small_push(ctx, need, keep)
     run_function, run_call = run_skip(ctx, list(layouts.values()), need, hl)
     return f"""#if {P}_ENABLE_PARSER
@@ -369,7 +378,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     if (size == 0u || size > len) {{
         return 0u;
     }}
-    for (i = 1u; i + hl <= size; i++) {{
+    for (i = 1u; i + hl <= size; i++) {{{skip}
         if (data[i] == h[0] && {p}__same(data + i, h, hl)) {{
             return 0u;
         }}

@@ -312,7 +312,10 @@ def throughput() -> Table:
         f"instr/B: instructions per byte (valgrind cachegrind, the first {PROBE // 1024} kB of the stream, two passes "
         "minus none): the load on a shared machine does not change them; the last column is the speed ratio they give.",
         "The generated parser takes a whole frame at once when it holds no byte and no other header lies inside the "
-        "frame. Otherwise, for length-byte frames (FEETECH: header, id, length byte, content, sum), it keeps per byte "
+        "frame (length-byte frames: also when it holds fewer bytes than a header, none beginning one, and a corrupt "
+        "whole frame is counted at once; a run of the header's byte in which every candidate is no frame, FEETECH's "
+        "adversarial stream, is skipped at once). Otherwise, for length-byte frames (FEETECH: header, id, length byte, "
+        "content, sum), it keeps per byte "
         "held whether a candidate starts there, whether its size is known and whether it is corrupt behind one that "
         "waits, and looks back over the bytes held only when a candidate ends with the byte or the one at the front "
         "turns out to be no frame (the adversarial stream: a candidate at every byte, each no frame once its first "

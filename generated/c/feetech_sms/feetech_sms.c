@@ -1822,13 +1822,15 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
 #endif
 
 #if FEETECH_SMS_PARSER_WHOLE_FRAMES
-/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
- * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
-static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
+/* A whole frame at data[0..len) while the parser holds fewer bytes than a header: taken at once when that gives what
+ * pushing its bytes would (no header begins in the bytes held, a plausible frame that fits, no header inside it, so no
+ * other candidate could end first). A frame that decodes: *taken 1; a corrupt one: *taken 0, counted in errors, its
+ * last bytes held as the scan holds a tail. Returns the bytes of data it took, 0 when it does not apply. */
+static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out, int *taken)
 {
-    const size_t hl = 2u;
-    const uint8_t *h = feetech_sms__h_request_0;
-    size_t i, size;
+    const size_t hl = 2u, held = p->n;
+    const uint8_t *h = feetech_sms__h_request_0, *tail = p->buf;
+    size_t i, k, size;
     if (len < (FEETECH_SMS__RX(p->dir) == FEETECH_SMS_REQUEST ? 5u : 4u) || !feetech_sms__same(data, h, hl)) {
         return 0u;
     }
@@ -1837,17 +1839,82 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
         return 0u;
     }
     for (i = 1u; i + hl <= size; i++) {
+        if (data[i + hl - 1u] != 0xffu) { /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }
         if (data[i] == h[0] && feetech_sms__same(data + i, h, hl)) {
             return 0u;
         }
     }
-    if (feetech_sms__take(FEETECH_SMS__RX(p->dir), data, size, out) != FEETECH_SMS_OK) {
+#if !FEETECH_SMS_PARSER_SMALL
+    tail += p->first;
+#endif
+    for (i = 0u; i < held; i++) { /* the bytes held (no candidate: fewer than a header's) begin no header */
+        for (k = 0u; k < hl && (i + k < held ? tail[i + k] : data[i + k - held]) == h[k]; k++) {
+        }
+        if (k == hl) {
+            return 0u;
+        }
+    }
+    p->garbage += (uint32_t)held;
+    p->n = 0u;
+#if !FEETECH_SMS_PARSER_SMALL
+    p->first = 0u;
+    p->wake = 0u;
+#endif
+    *taken = feetech_sms__take(FEETECH_SMS__RX(p->dir), data, size, out) == FEETECH_SMS_OK;
+    if (*taken) {
+        p->frames++;
+        p->frame = data;
+        p->frame_len = size;
+        return size;
+    }
+    p->errors++;
+    p->garbage += (uint32_t)(size - 1u);
+    for (i = 0u; i < 1u; i++) { /* the tail the scan keeps: it could begin a header */
+        p->buf[i] = data[size - 1u + i];
+#if !FEETECH_SMS_PARSER_SMALL
+        p->verdict[i] = 0u;
+#endif
+    }
+    p->n = 1u;
+    return size;
+}
+#endif
+
+#if !FEETECH_SMS_PARSER_SMALL
+/* A run of 0xff, the header's byte, while the bytes held are that byte and fewer than a candidate's first
+ * bytes: every candidate with its first bytes inside the run is no frame (a value of its prefix out of range), so the
+ * parser ends as pushing the run byte by byte leaves it: holding the run's last first-bytes-less-one bytes (candidates
+ * not sized yet), the rest garbage. The bytes of data taken, 0 when it does not apply. */
+static size_t feetech_sms__run(feetech_sms_parser_t *p, const uint8_t *data, size_t len)
+{
+    const size_t need = (FEETECH_SMS__RX(p->dir) == FEETECH_SMS_REQUEST ? 5u : 4u), hl = 2u;
+    size_t i, r = 0u, held = p->n;
+    if (held >= need) {
         return 0u;
     }
-    p->frames++;
-    p->frame = data;
-    p->frame_len = size;
-    return size;
+    for (i = 0u; i < held; i++) {
+        if (p->buf[p->first + i] != 0xffu) {
+            return 0u;
+        }
+    }
+    while (r < len && data[r] == 0xffu) {
+        r++;
+    }
+    if (held + r < need) {
+        return 0u;
+    }
+    p->garbage += (uint32_t)(held + r - (need - 1u));
+    p->n = need - 1u;
+    p->first = 0u;
+    p->wake = 0u;
+    for (i = 0u; i < need - 1u; i++) {
+        p->buf[i] = 0xffu;
+        p->verdict[i] = i + hl <= need - 1u ? FEETECH_SMS__C_NEW : 0u;
+    }
+    return r;
 }
 #endif
 
@@ -1862,11 +1929,25 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
 #endif
     for (i = 0u; i < len; i++) {
 #if FEETECH_SMS_PARSER_WHOLE_FRAMES
-        if (parser->n == 0u) {
-            size_t size = feetech_sms__whole(parser, data + i, len - i, out);
-            if (size > 0u) {
+        if (parser->n < 2u) {
+            int taken = 0;
+            size_t size = feetech_sms__whole(parser, data + i, len - i, out, &taken);
+            if (taken) {
                 *got = true;
                 return i + size;
+            }
+            if (size > 0u) { /* a corrupt frame, counted */
+                i += size - 1u;
+                continue;
+            }
+        }
+#endif
+#if !FEETECH_SMS_PARSER_SMALL
+        if (data[i] == 0xffu && i + 2u < len && data[i + 2u] == 0xffu) { /* a run: skipped */
+            size_t run = feetech_sms__run(parser, data + i, len - i);
+            if (run > 0u) {
+                i += run - 1u;
+                continue;
             }
         }
 #endif

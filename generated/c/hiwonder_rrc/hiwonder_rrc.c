@@ -4629,13 +4629,15 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
 #endif
 
 #if HIWONDER_RRC_PARSER_WHOLE_FRAMES
-/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
- * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
-static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
+/* A whole frame at data[0..len) while the parser holds fewer bytes than a header: taken at once when that gives what
+ * pushing its bytes would (no header begins in the bytes held, a plausible frame that fits, no header inside it, so no
+ * other candidate could end first). A frame that decodes: *taken 1; a corrupt one: *taken 0, counted in errors, its
+ * last bytes held as the scan holds a tail. Returns the bytes of data it took, 0 when it does not apply. */
+static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, int *taken)
 {
-    const size_t hl = 2u;
-    const uint8_t *h = hiwonder_rrc__h_request_0;
-    size_t i, size;
+    const size_t hl = 2u, held = p->n;
+    const uint8_t *h = hiwonder_rrc__h_request_0, *tail = p->buf;
+    size_t i, k, size;
     if (len < 4u || !hiwonder_rrc__same(data, h, hl)) {
         return 0u;
     }
@@ -4644,16 +4646,46 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
         return 0u;
     }
     for (i = 1u; i + hl <= size; i++) {
+        if (data[i + hl - 1u] != 0x55u && data[i + hl - 1u] != 0xaau) { /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }
         if (data[i] == h[0] && hiwonder_rrc__same(data + i, h, hl)) {
             return 0u;
         }
     }
-    if (hiwonder_rrc__take(HIWONDER_RRC__RX(p->dir), data, size, out) != HIWONDER_RRC_OK) {
-        return 0u;
+#if !HIWONDER_RRC_PARSER_SMALL
+    tail += p->first;
+#endif
+    for (i = 0u; i < held; i++) { /* the bytes held (no candidate: fewer than a header's) begin no header */
+        for (k = 0u; k < hl && (i + k < held ? tail[i + k] : data[i + k - held]) == h[k]; k++) {
+        }
+        if (k == hl) {
+            return 0u;
+        }
     }
-    p->frames++;
-    p->frame = data;
-    p->frame_len = size;
+    p->garbage += (uint32_t)held;
+    p->n = 0u;
+#if !HIWONDER_RRC_PARSER_SMALL
+    p->first = 0u;
+    p->wake = 0u;
+#endif
+    *taken = hiwonder_rrc__take(HIWONDER_RRC__RX(p->dir), data, size, out) == HIWONDER_RRC_OK;
+    if (*taken) {
+        p->frames++;
+        p->frame = data;
+        p->frame_len = size;
+        return size;
+    }
+    p->errors++;
+    p->garbage += (uint32_t)(size - 1u);
+    for (i = 0u; i < 1u; i++) { /* the tail the scan keeps: it could begin a header */
+        p->buf[i] = data[size - 1u + i];
+#if !HIWONDER_RRC_PARSER_SMALL
+        p->verdict[i] = 0u;
+#endif
+    }
+    p->n = 1u;
     return size;
 }
 #endif
@@ -4669,11 +4701,16 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
 #endif
     for (i = 0u; i < len; i++) {
 #if HIWONDER_RRC_PARSER_WHOLE_FRAMES
-        if (parser->n == 0u) {
-            size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
-            if (size > 0u) {
+        if (parser->n < 2u) {
+            int taken = 0;
+            size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out, &taken);
+            if (taken) {
                 *got = true;
                 return i + size;
+            }
+            if (size > 0u) { /* a corrupt frame, counted */
+                i += size - 1u;
+                continue;
             }
         }
 #endif

@@ -64,6 +64,34 @@ def prefix(layout: FrameLayout) -> int:
     return last + 1
 
 
+def run_byte(layouts: list[FrameLayout]) -> int | None:
+    """The byte whose runs the parser skips, or None: every layout's header is that byte repeated, and a candidate whose
+    first bytes are all that byte is no frame (a narrowed value of it out of range: the size function's first test),
+    with room after its header for a candidate inside the bytes kept. Inside such a run every candidate with a
+    whole prefix in the run is no frame, so pushing the run one byte at a time leaves the parser holding its last
+    prefix - 1 bytes, the rest garbage."""
+    heads = {layout.header for layout in layouts}
+    if len(heads) != 1:
+        return None
+    (head,) = heads
+    if len(set(head)) != 1:
+        return None
+    byte = head[0]
+    for layout in layouts:
+        if prefix(layout) - 1 < len(head):
+            return None
+        dead = False
+        for e in layout.value_elements:
+            if e.type is None or not _narrowed(e) or e.type.signed or e.type.is_float or e.type.size > 4:
+                continue
+            value = int.from_bytes(bytes([byte]) * e.type.size, "big")
+            if (value < e.minimum or value > e.maximum) and value != e.broadcast:
+                dead = True
+        if not dead:
+            return None
+    return byte
+
+
 def _by_direction(protocol: Protocol, P: str, values: dict[Direction, str]) -> str:
     """A C expression of p->dir: the one value when every direction has it."""
     known = [d for d in DIRECTIONS if d in values]
@@ -158,7 +186,18 @@ def parser(ctx: Ctx) -> str:
     else:
         starts = f"n >= {hl} && {p}__same(b + end - {hl}, {header}, {hl})"
     keep = max(len(layout.header) for layout in layouts.values()) - 1
+    hl_feed = hl.replace("p->dir", "parser->dir")
+    skip = ""  # one header: a byte that is none of its bytes ends no header that covers it, so none starts before it
+    if len(heads) == 1:
+        (head,) = heads
+        outside = " && ".join(f"data[i + hl - 1u] != 0x{c:02x}u" for c in sorted(set(head)))
+        skip = f"""
+        if ({outside}) {{ /* no header covers this byte: the next can start after it */
+            i += hl - 1u;
+            continue;
+        }}"""
     small = small_push(ctx, need, keep)
+    run_function, run_call = run_skip(ctx, list(layouts.values()), need, hl)
     return f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
  * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
@@ -329,13 +368,15 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
 #endif
 
 #if {P}_PARSER_WHOLE_FRAMES
-/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
- * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
-static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
+/* A whole frame at data[0..len) while the parser holds fewer bytes than a header: taken at once when that gives what
+ * pushing its bytes would (no header begins in the bytes held, a plausible frame that fits, no header inside it, so no
+ * other candidate could end first). A frame that decodes: *taken 1; a corrupt one: *taken 0, counted in errors, its
+ * last bytes held as the scan holds a tail. Returns the bytes of data it took, 0 when it does not apply. */
+static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out, int *taken)
 {{
-    const size_t hl = {hl};
-    const uint8_t *h = {header};
-    size_t i, size;
+    const size_t hl = {hl}, held = p->n;
+    const uint8_t *h = {header}, *tail = p->buf;
+    size_t i, k, size;
     if (len < {need} || !{p}__same(data, h, hl)) {{
         return 0u;
     }}
@@ -343,22 +384,48 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     if (size == 0u || size > len) {{
         return 0u;
     }}
-    for (i = 1u; i + hl <= size; i++) {{
+    for (i = 1u; i + hl <= size; i++) {{{skip}
         if (data[i] == h[0] && {p}__same(data + i, h, hl)) {{
             return 0u;
         }}
     }}
-    if ({p}__take({P}__RX(p->dir), data, size, out) != {P}_OK) {{
-        return 0u;
+#if !{P}_PARSER_SMALL
+    tail += p->first;
+#endif
+    for (i = 0u; i < held; i++) {{ /* the bytes held (no candidate: fewer than a header's) begin no header */
+        for (k = 0u; k < hl && (i + k < held ? tail[i + k] : data[i + k - held]) == h[k]; k++) {{
+        }}
+        if (k == hl) {{
+            return 0u;
+        }}
     }}
-    p->frames++;
-    p->frame = data;
-    p->frame_len = size;
+    p->garbage += (uint32_t)held;
+    p->n = 0u;
+#if !{P}_PARSER_SMALL
+    p->first = 0u;
+    p->wake = 0u;
+#endif
+    *taken = {p}__take({P}__RX(p->dir), data, size, out) == {P}_OK;
+    if (*taken) {{
+        p->frames++;
+        p->frame = data;
+        p->frame_len = size;
+        return size;
+    }}
+    p->errors++;
+    p->garbage += (uint32_t)(size - {keep}u);
+    for (i = 0u; i < {keep}u; i++) {{ /* the tail the scan keeps: it could begin a header */
+        p->buf[i] = data[size - {keep}u + i];
+#if !{P}_PARSER_SMALL
+        p->verdict[i] = 0u;
+#endif
+    }}
+    p->n = {keep}u;
     return size;
 }}
 #endif
 
-size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
+{run_function}size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
 {{
     size_t i;
     *got = false;
@@ -369,14 +436,19 @@ size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p
 #endif
     for (i = 0u; i < len; i++) {{
 #if {P}_PARSER_WHOLE_FRAMES
-        if (parser->n == 0u) {{
-            size_t size = {p}__whole(parser, data + i, len - i, out);
-            if (size > 0u) {{
+        if (parser->n < {hl_feed}) {{
+            int taken = 0;
+            size_t size = {p}__whole(parser, data + i, len - i, out, &taken);
+            if (taken) {{
                 *got = true;
                 return i + size;
             }}
+            if (size > 0u) {{ /* a corrupt frame, counted */
+                i += size - 1u;
+                continue;
+            }}
         }}
-#endif
+#endif{run_call}
         if ({p}__push(parser, data[i], out)) {{
             *got = true;
             return i + 1u;
@@ -396,6 +468,62 @@ void {p}_parser_gap({p}_parser_t *parser)
 }}
 {parser_api.push_function(p, P, None)}{parser_api.frame_function(p)}{parser_api.expect_function(p, P, True)}#endif
 """
+
+
+def run_skip(ctx: Ctx, layouts: list[FrameLayout], need: str, hl: str) -> tuple[str, str]:
+    """The default parser's skip over a run of the header's byte (see run_byte), and its call in feed; nothing where
+    it does not apply."""
+    p, P = ctx.p, ctx.P
+    byte = run_byte(layouts)
+    if byte is None:
+        return "", ""
+    function = f"""#if !{P}_PARSER_SMALL
+/* A run of 0x{byte:02x}, the header's byte, while the bytes held are that byte and fewer than a candidate's first
+ * bytes: every candidate with its first bytes inside the run is no frame (a value of its prefix out of range), so the
+ * parser ends as pushing the run byte by byte leaves it: holding the run's last first-bytes-less-one bytes (candidates
+ * not sized yet), the rest garbage. The bytes of data taken, 0 when it does not apply. */
+static size_t {p}__run({p}_parser_t *p, const uint8_t *data, size_t len)
+{{
+    const size_t need = {need}, hl = {hl};
+    size_t i, r = 0u, held = p->n;
+    if (held >= need) {{
+        return 0u;
+    }}
+    for (i = 0u; i < held; i++) {{
+        if (p->buf[p->first + i] != 0x{byte:02x}u) {{
+            return 0u;
+        }}
+    }}
+    while (r < len && data[r] == 0x{byte:02x}u) {{
+        r++;
+    }}
+    if (held + r < need) {{
+        return 0u;
+    }}
+    p->garbage += (uint32_t)(held + r - (need - 1u));
+    p->n = need - 1u;
+    p->first = 0u;
+    p->wake = 0u;
+    for (i = 0u; i < need - 1u; i++) {{
+        p->buf[i] = 0x{byte:02x}u;
+        p->verdict[i] = i + hl <= need - 1u ? {P}__C_NEW : 0u;
+    }}
+    return r;
+}}
+#endif
+
+"""
+    call = f"""
+#if !{P}_PARSER_SMALL
+        if (data[i] == 0x{byte:02x}u && i + {hl} < len && data[i + {hl}] == 0x{byte:02x}u) {{ /* a run: skipped */
+            size_t run = {p}__run(parser, data + i, len - i);
+            if (run > 0u) {{
+                i += run - 1u;
+                continue;
+            }}
+        }}
+#endif"""
+    return function, call
 
 
 def small_push(ctx: Ctx, need: str, keep: int) -> str:

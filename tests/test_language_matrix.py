@@ -306,7 +306,8 @@ CASES: dict[str, Case] = {
                     "type": "u16",
                     "endian": "big",
                     "counts": ["code", "checksum"],
-                    "range": [5, 1000],  # a candidate whose length is outside it is no frame
+                    # a candidate whose length is outside it is no frame (3: code and checksum, no content)
+                    "range": [3, 1000],
                 },
                 "code": {"role": "command", "type": "u8"},
                 "content": {"role": "content"},

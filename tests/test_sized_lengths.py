@@ -167,3 +167,18 @@ def test_a_frame_whose_length_is_outside_its_range_is_no_frame(length: dict[str,
         with pytest.raises(EncodeError) as refused_encode:
             package.encode(package.NoteRequest(data=b"seven!!"))  # 7 bytes: a length of 7
         assert str(refused_encode.value) == "request frame: length = 7 is outside its range 1..6"
+
+
+def test_a_fixed_size_frame_whose_length_is_outside_its_range_is_refused_on_encode() -> None:
+    """A command of one content size has an inline encoder with its length as a constant: that constant is held to
+    the range too (it once sent a length of 8 that decode and the stream parser then refused)."""
+    text = framed_spec({"type": "u16", "endian": "big", "range": [1, 6]}).replace(
+        "data:\n          type: bytes\n          size: rest", "a: u32\n        b: u32"
+    )
+    assert "b: u32" in text
+    protocol = resolve(load_text(text, "ranged.yaml"))
+    files = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+    with imported("ranged", files, "the ranged length test") as package:
+        with pytest.raises(EncodeError) as refused:
+            package.encode(package.NoteRequest(a=1, b=2))
+        assert str(refused.value) == "request frame: length = 8 is outside its range 1..6"

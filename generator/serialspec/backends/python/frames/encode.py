@@ -289,7 +289,7 @@ def frame_encoder(
                 if size is None:
                     return None
                 lengths[index] += size
-        if all(0 <= value < 1 << (8 * layout.elements[i].size) for i, value in lengths.items()):
+        if all(_holds(layout.elements[i], value) for i, value in lengths.items()):
             chosen = (layout, checks, lengths)
             break
     if chosen is None:
@@ -298,6 +298,12 @@ def frame_encoder(
     lines = _frame_lines(layout, checks, lengths, parts, formats, code, values, struct)
     # the frame is made in the first statement: the one that packs the content's lists
     return [Code(lines[0], lists=packed_lists(parts)), *(Code(line) for line in lines[1:])]
+
+
+def _holds(element: Element, value: int) -> bool:
+    """A length element can send `value`: its bytes hold it and its `range` (if any) takes it."""
+    low, high = element.limits or (0, (1 << (8 * element.size)) - 1)
+    return 0 <= value < 1 << (8 * element.size) and low <= value <= high
 
 
 def _frame_lines(

@@ -23,7 +23,7 @@ import pytest
 from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, Timeout
 from sim_process import serve
 
 if importlib.util.find_spec("Mock") is None:  # before tmc_driver imports it (see the module docstring)
@@ -275,6 +275,9 @@ def test_the_generated_client_against_the_sim(tmc: ModuleType, sim_path: str) ->
         assert driver.read_chopconf(sync, 0).mres == tmc.Microsteps.MS16
         with pytest.raises(Exception, match="outside its range"):
             driver.write_sgthrs(sync, 0, 256)
+        # Found here: replies carry no node address (0xFF), so the Timeout named no device ("from the device")
+        with pytest.raises(Timeout, match="^no reply to read_gconf from node=1 within"):
+            driver.read_gconf(sync, 1)
 
 
 def test_client_arguments_of_frame_values_with_bit_fields_are_their_bits_class(tmc: ModuleType) -> None:

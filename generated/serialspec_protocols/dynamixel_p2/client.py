@@ -63,6 +63,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),
+    address='id',
 )
 
 

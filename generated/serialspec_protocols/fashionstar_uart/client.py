@@ -95,6 +95,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
+    address='servo_id',
 )
 
 #: Servo parameters by data_id: entry name -> data_id.

@@ -54,6 +54,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),
+    address='id',
     describe_status=flag_names({'error': ErrorStatus}),
 )
 

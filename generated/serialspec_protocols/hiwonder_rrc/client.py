@@ -94,6 +94,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
+    address='servo_id',
 )
 
 

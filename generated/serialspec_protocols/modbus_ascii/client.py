@@ -60,6 +60,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
+    address='unit',
     errors=ErrorReplies(ExceptionResponse, 'function', 'exception_code', {'read_coils': 0x01, 'read_discrete_inputs': 0x02, 'read_holding_registers': 0x03, 'read_input_registers': 0x04, 'write_coil': 0x05, 'write_register': 0x06, 'write_coils': 0x0f, 'write_registers': 0x10, 'mask_write_register': 0x16, 'read_write_registers': 0x17}),
 )
 

@@ -85,6 +85,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
+    address='address',
 )
 
 

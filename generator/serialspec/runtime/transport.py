@@ -114,6 +114,7 @@ class Binding:
     parser: Callable[[], StreamParser]  # a parser for what the host receives (responses)
     match_by: tuple[str, ...]  # `command`, `subcommand` or field names, from the spec's `matching.by`
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
+    address: str = ""  # the request field holding the device id: a Timeout names it, also where replies do not
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
     errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
     # decode(frame, "response", expect): one whole reply, or DecodeError; a transaction's read of exactly the size
@@ -912,7 +913,11 @@ class Bus:
                 self._last_io = monotonic()
 
     def _device(self, request: Message) -> str:
-        parts = [f"{n}={getattr(request, n)}" for n in self.binding.match_by if hasattr(request, n)]
+        """The device a request went to, as its Timeout names it: the fields replies are matched by, and its id."""
+        names = list(self.binding.match_by)
+        if self.binding.address and self.binding.address not in names:
+            names.append(self.binding.address)
+        parts = [f"{n}={getattr(request, n)}" for n in names if hasattr(request, n)]
         return " ".join(parts)
 
     def _check_status(self, reply: Message) -> None:

@@ -136,18 +136,17 @@ class Scanner:
         given as `field.bit_field` made into their class), the fields' defaults for the others."""
         given: dict[str, Any] = {}
         for name, value in values.items():
-            number = int(value) if float(value).is_integer() else value
             base, _, bit = name.partition(".")
             if bit:
-                given.setdefault(base, {})[bit] = number
+                given.setdefault(base, {})[bit] = _whole(value)
             else:
-                given[base] = number
+                given[base] = _whole(value)
         spec = next(m for m in self.protocol.messages() if m.class_name == cls.__name__)
         layout = self.protocol.framing.layouts[Direction.REQUEST]
         scalars = [f for f in (*layout.value_elements, *spec.fields) if not isinstance(f, Scalar) or not f.hidden]
         for f in scalars:
             if isinstance(f, Scalar) and f.default is not None:
-                given.setdefault(f.name, int(f.default) if float(f.default).is_integer() else f.default)
+                given.setdefault(f.name, _whole(f.default))
             bits_class = getattr(f, "bits_class", "")
             if bits_class and isinstance(given.get(f.name), dict):
                 given[f.name] = getattr(self.package, bits_class).from_fields(given[f.name])
@@ -362,3 +361,8 @@ def _rates(args: argparse.Namespace, protocol: Protocol) -> list[int]:
         if rate <= 0:
             raise SerialspecError(f"--baudrate {rate}: give a positive number of bits per second")
     return rates or [protocol.serial.baudrate]
+
+
+def _whole(value: float) -> float:
+    """A spec's number as an int where it is whole (a field's value), else as it is."""
+    return int(value) if float(value).is_integer() else value

@@ -1241,7 +1241,8 @@ DEVICE_COMMAND = Obj(
             Str(),
             "State variables or memory entries the command adds 1 to each time the device carries out a request "
             "that is not refused: a count of the writes taken (the TMC2209's IFCNT: `increments: [ifcnt]`, with "
-            "`modulo: {ifcnt: 256}` for a count that wraps past 255).",
+            "`modulo: {ifcnt: 256}` for a count that wraps past 255); `step` on a message the device sends "
+            "(`device.sends`) does the same for each send.",
             example=["ifcnt"],
         ),
         "wraps": MapOf(

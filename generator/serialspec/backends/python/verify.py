@@ -36,8 +36,13 @@ def _raw_hint(found: object, recorded: object) -> str:
     """Where a value was recorded by its enum member's name (`found`: the decoded message's member): examples record
     what the wire carries."""
     name = getattr(found, "name", None)
-    if isinstance(recorded, str) and isinstance(name, str) and name.lower() == recorded.lower():
-        return f" (examples record wire values: write {int(found)}, which is {recorded})"  # type: ignore[call-overload]
+    if (
+        isinstance(found, int)
+        and isinstance(recorded, str)
+        and isinstance(name, str)
+        and name.lower() == recorded.lower()
+    ):
+        return f" (examples record wire values: write {int(found)}, which is {recorded})"
     return ""
 
 

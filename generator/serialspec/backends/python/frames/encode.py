@@ -302,8 +302,7 @@ def frame_encoder(
 
 def _holds(element: Element, value: int) -> bool:
     """A length element can send `value`: its bytes hold it and its `range` (if any) takes it."""
-    low, high = element.limits or (0, (1 << (8 * element.size)) - 1)
-    return 0 <= value < 1 << (8 * element.size) and low <= value <= high
+    return 0 <= value < 1 << (8 * element.size) and not element.length_outside(value)
 
 
 def _frame_lines(

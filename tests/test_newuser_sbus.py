@@ -87,3 +87,23 @@ def test_a_message_built_with_a_list_equals_its_decoded_frame(sb: ModuleType) ->
     """A list given for an array field (the natural Python spelling) is stored as the tuple decode gives."""
     message = sb.ChannelsResponse(channels=[992] * 16, flags=sb.FlagsBits(0, 0, 0, 0))
     assert sb.decode(sb.encode(message), sb.Direction.RESPONSE) == message
+
+
+def test_a_bit_field_may_be_given_by_its_bit_alone() -> None:
+    """Found writing this spec: `frame_lost: 2` under `bits:` (as flags take it) was refused, "expected a mapping"; a
+    bit number or [high, low] alone is the short form of `{bits: ...}`."""
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    text = SPEC.read_text(encoding="utf-8")
+    short = text.replace("{bits: 0, description: Digital channel 17.}", "0").replace(
+        "{bits: 3, description: The receiver is in failsafe.}", "[3, 3]"
+    )
+    assert short != text
+
+    def flag_bits(spec: str) -> list[tuple[str, int, int]]:
+        [command] = resolve(load_text(spec, "sbus.yaml")).commands
+        flags = next(f for f in command.response.fields if f.name == "flags")  # type: ignore[union-attr]
+        return [(b.name, b.high, b.low) for b in flags.bits]  # type: ignore[attr-defined]
+
+    assert flag_bits(short) == flag_bits(text)

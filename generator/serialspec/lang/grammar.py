@@ -342,15 +342,24 @@ HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'."
 
 def bit_fields(description: str) -> MapOf:
     """Sub-fields of an integer by bit position: a field's or a frame element's `bits`."""
+    where = "A bit number, or [high, low] for several bits."
     return MapOf(
-        Obj(
-            {
-                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
-                "enum": Str("Name of an entry in `enums:`."),
-                "description": TEXT,
-            },
-            required=("bits",),
-            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
+        OneOf(
+            (
+                Int(where),
+                ListOf(Int(), where, length=2),
+                Obj(
+                    {
+                        "bits": OneOf((Int(), ListOf(Int(), length=2)), where),
+                        "enum": Str("Name of an entry in `enums:`."),
+                        "description": TEXT,
+                    },
+                    required=("bits",),
+                    description="One sub-field in full: its bit (or bits) and the enum its value belongs to, if any.",
+                ),
+            ),
+            "One sub-field: its bit number or [high, low] bits (short form, `failsafe: 3`, `error: [6, 0]`), or a "
+            "mapping with `bits` and optionally the enum its value belongs to.",
         ),
         description,
     )

@@ -454,6 +454,8 @@ class FieldResolver(Pass):
         for bit_name, bit_spec in (spec.get("bits") or {}).items():
             bit_path = (*path, "bits", bit_name)
             self.name(bit_name, bit_path, "bit field name")
+            if not isinstance(bit_spec, dict):  # the short form: the bit number or [high, low] alone
+                bit_spec = {"bits": bit_spec}
             where = bit_spec["bits"]
             high_bit, low_bit = (where, where) if isinstance(where, int) else (where[0], where[1])
             if not 0 <= low_bit <= high_bit < scalar.size * 8:

@@ -182,3 +182,39 @@ def test_a_fixed_size_frame_whose_length_is_outside_its_range_is_refused_on_enco
         with pytest.raises(EncodeError) as refused:
             package.encode(package.NoteRequest(a=1, b=2))
         assert str(refused.value) == "request frame: length = 8 is outside its range 1..6"
+
+
+def test_a_length_may_count_itself() -> None:
+    """Found writing an LX-16A spec as a newcomer: its length is "N parameters + 3", counting itself, the command and
+    the checksum (`counts: [length, checksum]`), which was refused ("the length must come before what it counts");
+    it reads as counting from the next element with its own size added. SERVO_POS_READ to servo 1 is 55 55 01 03 1C DF
+    in the LX-16A document."""
+    text = yaml.safe_dump(
+        SPEC
+        | {
+            "protocol": "selfcount",
+            "title": "Self-counting length",
+            "framing": {
+                "elements": {
+                    "header": {"role": "header", "value": "55 55"},
+                    "id": {"role": "address", "type": "u8"},
+                    "length": {"role": "length", "type": "u8", "counts": ["length", "checksum"]},
+                    "code": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "checksum": {"role": "checksum", "algorithm": "sum", "invert": True, "covers": ["id", "content"]},
+                }
+            },
+            "commands": {
+                "pos_read": {"code": 0x1C, "request": {"fields": {}}},
+                "move": {"code": 1, "request": {"fields": {"angle": "u16", "time": "u16"}}},
+            },
+        },
+        sort_keys=False,
+    )
+    protocol = resolve(load_text(text, "selfcount.yaml"))
+    files = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+    with imported("selfcount", files, "the self-counting length test") as package:
+        assert package.encode(package.PosReadRequest(id=1)) == bytes.fromhex("55 55 01 03 1c df")
+        move = bytes.fromhex("55 55 01 07 01 f4 01 e8 03 16")
+        assert package.decode(move, "request") == package.MoveRequest(id=1, angle=500, time=1000)
+        assert package.StreamParser("request").feed(b"\x00" + move) == [package.MoveRequest(id=1, angle=500, time=1000)]

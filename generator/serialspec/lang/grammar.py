@@ -868,7 +868,8 @@ FRAME_ELEMENT = Obj(
         ),
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
-            "it the bytes as sent); default the content only.",
+            "it the bytes as sent); default the content only. It may start at the length itself (LX-16A: "
+            "`counts: [length, checksum]`, N parameters + 3), which counts its own bytes too.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,

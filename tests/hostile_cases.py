@@ -248,7 +248,12 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.code: expected an integer, got text (text codes belong to `framing: {kind: text}`)",
     ),
     ("code true", "tiny", put("commands/move/code", True), "commands.move.code: expected an integer, got true/false"),
-    ("code float", "tiny", put("commands/move/code", 1.5), "commands.move.code: expected an integer, got a number"),
+    (
+        "code float",
+        "tiny",
+        put("commands/move/code", 1.5),
+        "commands.move.code: expected an integer, got a number (1.5)",
+    ),
     (
         "subcommand code 300",
         "rrc",

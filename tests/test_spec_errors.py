@@ -126,6 +126,9 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "angle: {type: i16, encoding: seven_bit}"), "seven_bit is for unsigned integers, not i16"),
         (("angle: i16", "t: {type: u16, encoding: seven_bit, range: [0, 16384]}"), "fit u16 seven_bit (0..16383)"),
         (("angle: i16", "t: {type: u16, encoding: seven_bit, const: 3}"), "`const` does not go with encoding seven"),
+        # a number where an integer or text is wanted said "unexpected a number", and never why 1.0 is not an integer
+        (("angle: i16", "t: {type: bytes, size: 2.0}"), "expected an integer or text, got a number (2.0):"),
+        (("angle: i16", "t: {type: u8, bits: {a: 1.0}}"), "expected an integer or a list or a mapping, got a number"),
         (
             ("angle: i16", "n: {type: u16, encoding: seven_bit}\n        v: {type: array, of: u8, count: n}"),
             "'n' holds a count or size: plain, not encoding seven_bit",

@@ -270,7 +270,8 @@ class OneOf(Shape):
             if _accepts_kind(option, value):
                 yield from problems
                 return
-        yield path, f"unexpected {_kind(value)}: {self.description}"
+        wanted = " or ".join(dict.fromkeys(_WANTED.get(type(option), "something else") for option in self.options))
+        yield path, f"expected {wanted}, got {_kind(value)}: {self.description}"
 
     def json_schema(self) -> dict[str, Any]:
         options = [_described(option, self.description) for option in self.options]
@@ -316,9 +317,22 @@ def _accepts_kind(shape: Shape, value: Any) -> bool:
     return expected is not None and isinstance(value, expected)
 
 
+_WANTED: dict[type[Shape], str] = {
+    Str: "text",
+    Int: "an integer",
+    Num: "a number",
+    Bool: "true or false",
+    ListOf: "a list",
+    MapOf: "a mapping",
+    Obj: "a mapping",
+}
+
+
 def _kind(value: Any) -> str:
     if value is None:
         return "nothing"
+    if isinstance(value, float):
+        return f"a number ({value!r})"  # where an integer was wanted, 1.0 shows why it is not one
     return {
         bool: "true/false",
         int: "a number",

@@ -83,6 +83,25 @@ def test_xor_and_sum_checksums() -> None:
     assert sum_function(8, True)(bytes([1, 2, 3])) == 0xF9
 
 
+def frsky_sport_checksum(data: bytes) -> int:
+    """FrSky S.Port's checksum as its firmware computes it (OpenTX/EdgeTX `sportCheckSum`): the carry folded back in
+    at each byte, then 0xFF minus the sum."""
+    crc = 0
+    for byte in data:
+        crc += byte
+        crc += crc >> 8
+        crc &= 0xFF
+    return 0xFF - crc
+
+
+@settings(max_examples=examples(200), deadline=None)
+@given(st.binary(max_size=40) | st.lists(st.sampled_from([0x00, 0x01, 0xFE, 0xFF]), max_size=20).map(bytes))
+def test_a_sum_with_end_around_carry_is_frsky_sports(data: bytes) -> None:
+    assert sum_function(8, True, end_around_carry=True)(data) == frsky_sport_checksum(data)
+    total = sum(data)  # a 16-bit one's complement sum: congruent modulo 0xFFFF, 0 only for zeros
+    assert sum_function(16, False, end_around_carry=True)(data) == ((total - 1) % 0xFFFF + 1 if total else 0)
+
+
 # --- DYNAMIXEL: stuffing through the generated package ----------------------------------------------------------
 
 STUFF = bytes.fromhex("ff ff fd")

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "6c8d762517bf78ee4f24cce83bb9a94325827b271dbb7f7ba5feeef63346d03b"
+#define FEETECH_SMS_SPEC_SHA256 "15eb75594d1457e6bb2d904692433c1a2d9af1b6067b63e5430844f9e5cb2f14"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

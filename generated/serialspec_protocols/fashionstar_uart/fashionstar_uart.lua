@@ -2362,7 +2362,12 @@ CHECKSUMS["sum"] = function(spec, size, data)
   local mask = width_mask(size * 8)
   local total = 0
   for i = 1, #data do
-    total = (total + data:byte(i)) % (mask + 1)
+    total = total + data:byte(i)
+    if spec.end_around_carry then
+      total = band(total, mask) + rshift(total, size * 8)
+    else
+      total = total % (mask + 1)
+    end
   end
   if spec.invert then
     total = mask - total

@@ -1,5 +1,6 @@
 """`algorithm: sum`: the sum of the covered bytes modulo 2**width, optionally inverted (one's complement) or negated
-(two's complement), then optionally masked (HerkuleX: `& 0xFE`)."""
+(two's complement), then optionally masked (HerkuleX: `& 0xFE`). With `end_around_carry`, each carry out of the top
+bit is added back in (one's complement addition, FrSky S.Port: `0xFF - sum`, the sum folded at each byte)."""
 
 from __future__ import annotations
 
@@ -27,14 +28,36 @@ if TYPE_CHECKING:
     from typing import Any
 
 
-def sum_function(width: int, invert: bool, negate: bool = False, mask: int | None = None) -> Callable[[bytes], int]:
-    """Sum of the bytes modulo 2**width, optionally bitwise inverted or negated, then ANDed with `mask`."""
+def sum_function(
+    width: int, invert: bool, negate: bool = False, mask: int | None = None, end_around_carry: bool = False
+) -> Callable[[bytes], int]:
+    """Sum of the bytes modulo 2**width (or with end-around carry), optionally bitwise inverted or negated, then
+    ANDed with `mask`."""
     whole = (1 << width) - 1 & (mask if mask is not None else -1)
+    if end_around_carry:
+        return lambda data: finish(folded(sum(data), width), width, invert, negate, mask)
     if invert:
         return lambda data: ~sum(data) & whole
     if negate:
         return lambda data: -sum(data) & whole
     return lambda data: sum(data) & whole
+
+
+def folded(total: int, width: int) -> int:
+    """A sum of bytes with each carry out of the top of `width` bits added back in, as adding them one at a time
+    does: 0 for no bytes or zeros, else the value in 1..2**width-1 congruent to it modulo 2**width-1."""
+    top = (1 << width) - 1
+    return (total - 1) % top + 1 if total else 0
+
+
+END_AROUND = Key(
+    "end_around_carry",
+    "bool",
+    "sum: each carry out of the top bit is added back in (one's complement addition: FrSky S.Port's checksum, "
+    "`invert: true` on a u8, is 0xFF minus the bytes' sum folded so at each byte).",
+    default=False,
+    example=True,
+)
 
 
 @dataclass(frozen=True)
@@ -43,6 +66,7 @@ class Sum(Algorithm):
     invert: bool = False
     negate: bool = False
     mask: int | None = None  # ANDed with the result (None: none beyond the width)
+    end_around_carry: bool = False  # each carry out of the top bit added back in
 
     name = "sum"
     summary = "the sum of the bytes, modulo 2 to the checksum's bits"
@@ -50,6 +74,7 @@ class Sum(Algorithm):
         INVERT,
         Key("negate", "bool", "sum: the sum negated (two's complement).", default=False, example=True),
         MASK,
+        END_AROUND,
     )
     samples = (
         Sample("8-bit sum", "u8"),
@@ -57,6 +82,10 @@ class Sum(Algorithm):
         Sample("8-bit negated sum (two's complement)", "u8", {"negate": True}),
         Sample("8-bit inverted sum, masked", "u8", {"invert": True, "mask": 0xFE}),
         Sample("16-bit sum", "u16"),
+        Sample(
+            "8-bit sum with end-around carry, inverted (FrSky S.Port)", "u8", {"invert": True, "end_around_carry": True}
+        ),
+        Sample("16-bit sum with end-around carry", "u16", {"end_around_carry": True}),
     )
 
     @classmethod
@@ -64,7 +93,10 @@ class Sum(Algorithm):
         problem = finish_problem(raw, size * 8)
         if problem is not None:
             raise problem
-        return cls(size * 8, bool(raw.get("invert", False)), bool(raw.get("negate", False)), raw.get("mask"))
+        end_around = bool(raw.get("end_around_carry", False))
+        return cls(
+            size * 8, bool(raw.get("invert", False)), bool(raw.get("negate", False)), raw.get("mask"), end_around
+        )
 
     @property
     def whole(self) -> int:
@@ -76,32 +108,43 @@ class Sum(Algorithm):
         return "~" if self.invert else "-" if self.negate else ""
 
     def function(self) -> Callable[[bytes], int]:
-        return sum_function(self.width, self.invert, self.negate, self.mask)
+        return sum_function(self.width, self.invert, self.negate, self.mask, self.end_around_carry)
 
     def function_code(self) -> tuple[Import, str]:
         extra = (", negate=True" if self.negate else "") + (f", mask={self.mask:#x}" if self.mask is not None else "")
+        extra += ", end_around_carry=True" if self.end_around_carry else ""
         return ("serialspec.checksums.sum", "sum_function"), f"sum_function({self.width}, {self.invert}{extra})"
 
+    # With end-around carry the codec calls the runtime function (the base class's), which folds the sum once.
+
     def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
+        if self.end_around_carry:
+            return super().python_setup(name)
         return [], []  # the built-in sum(), in line
 
     def python_call(self, name: str) -> str:
+        if self.end_around_carry:
+            return super().python_call(name)
         return f"({self.python_sum('{}')})"
 
     def python_calls_function(self) -> bool:
-        return False
+        return self.end_around_carry
 
     def python_expression(self, name: str, covered: str) -> str:
+        if self.end_around_carry:
+            return self.python_call(name).format(covered)
         return self.python_sum(covered)
 
     def python_sum(self, covered: str) -> str:
         return f"{self.sign}sum({covered}) & {self.whole:#x}"
 
-    def byte_total(self, total: str) -> str:
+    def byte_total(self, total: str) -> str | None:
+        if self.end_around_carry:
+            return None
         return f"{self.sign}({total}) & {self.whole:#x}"
 
     def frame_test(self, total: str, skipped: int, check: str) -> str | None:
-        if self.width != 8 or self.mask is not None:
+        if self.width != 8 or self.mask is not None or self.end_around_carry:
             return None  # a wider check is more than one byte of the frame's sum; a mask loses bits
         if self.invert:  # the covered bytes and their inverted sum add up to 0xff
             return f"({total} - {skipped + 0xFF:#x}) & 0xff"
@@ -112,16 +155,21 @@ class Sum(Algorithm):
         return f"({total}{less} - 2 * {check}) & 0xff"
 
     def summed(self) -> bool | None:
-        return self.invert if self.width == 8 and not self.negate and self.mask is None else None
+        plain = not self.negate and self.mask is None and not self.end_around_carry
+        return self.invert if self.width == 8 and plain else None
 
     def c_code(self, prefix: str) -> CCode:
         t = c_uint(self.width)
-        name = f"{prefix}_sum{self.width}"
+        name = f"{prefix}_sum{self.width}" + ("_folded" if self.end_around_carry else "")
         mask = (1 << self.width) - 1
         final = "the sum inverted" if self.invert else "the sum negated" if self.negate else "the sum"
         final += f", ANDed with 0x{self.mask:x}" if self.mask is not None else ""
-        doc = (
-            f"/* Sum of the bytes modulo 2^{self.width}. Incremental: start with 0; the frame's checksum is {final}. */"
+        how = "with each carry out of the top bit added back in" if self.end_around_carry else f"modulo 2^{self.width}"
+        doc = f"/* Sum of the bytes {how}. Incremental: start with 0; the frame's checksum is {final}. */"
+        step = (
+            f"s = (s & 0x{mask:x}u) + (s >> {self.width}); /* the carry, added back in */"
+            if self.end_around_carry
+            else ""
         )
         body = f"""{doc}
 {t} {name}({t} acc, const uint8_t *data, size_t n)
@@ -129,7 +177,7 @@ class Sum(Algorithm):
     uint32_t s = acc;
     size_t i;
     for (i = 0; i < n; i++) {{
-        s += data[i];
+        s += data[i];{chr(10) + "        " + step if step else ""}
     }}
     return ({t})(s & 0x{mask:x}u);
 }}
@@ -144,11 +192,14 @@ class Sum(Algorithm):
 
     def lua_parameters(self) -> dict[str, Any]:
         masked = {} if self.mask is None else {"mask": self.mask}
-        return {"invert": self.invert, "negate": self.negate} | masked
+        folded = {"end_around_carry": True} if self.end_around_carry else {}
+        return {"invert": self.invert, "negate": self.negate} | masked | folded
 
     def describe(self) -> str:
         what = "bitwise NOT of the sum" if self.invert else "two's complement of the sum" if self.negate else "sum"
         masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
+        if self.end_around_carry:
+            return f"{what} of the covered bytes, each carry out of bit {self.width - 1} added back in{masked}"
         return f"{what} of the covered bytes, modulo {1 << self.width}{masked}"
 
     def parameters(self) -> list[tuple[str, str]]:
@@ -158,7 +209,10 @@ class Sum(Algorithm):
         sign = self.sign
         terms = " + ".join(f"0x{b:02X}" for b in covered) or "0"
         masked = f" & {hex_value(self.mask, self.width)}" if self.mask is not None else ""
-        value = hex_value(finish(sum(covered), self.width, self.invert, self.negate, self.mask), self.width)
+        total = folded(sum(covered), self.width) if self.end_around_carry else sum(covered)
+        value = hex_value(finish(total, self.width, self.invert, self.negate, self.mask), self.width)
+        if self.end_around_carry:
+            return f"{sign}fold({terms}){masked} = {sign}fold({sum(covered):#x}) = {sign}{total:#x}{masked} → {value}"
         return f"{sign}({terms}){masked} = {sign}{sum(covered):#x}{masked} → {value}"
 
 
@@ -167,7 +221,12 @@ _LUA = """function(spec, size, data)
   local mask = width_mask(size * 8)
   local total = 0
   for i = 1, #data do
-    total = (total + data:byte(i)) % (mask + 1)
+    total = total + data:byte(i)
+    if spec.end_around_carry then
+      total = band(total, mask) + rshift(total, size * 8)
+    else
+      total = total % (mask + 1)
+    end
   end
   if spec.invert then
     total = mask - total

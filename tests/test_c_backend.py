@@ -64,6 +64,7 @@ FLAGS = [
     "-Wmissing-prototypes",
     "-Wbad-function-cast",
     "-Wdouble-promotion",
+    "-Wfloat-equal",
     "-Wformat=2",
     "-Wnull-dereference",
     "-Wpointer-arith",

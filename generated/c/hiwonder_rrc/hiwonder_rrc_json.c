@@ -55,7 +55,7 @@ static void hiwonder_rrc__wi(hiwonder_rrc__w_t *w, int32_t v)
 static void hiwonder_rrc__wf(hiwonder_rrc__w_t *w, double v)
 {
     char t[40];
-    if (v != v) {
+    if (!(v >= 0.0 || v < 0.0)) { /* NaN (compared so, not v != v: clean under -Wfloat-equal) */
         hiwonder_rrc__ws(w, "NaN");
     } else if (v > 1.7976931348623157e308) {
         hiwonder_rrc__ws(w, "Infinity");

@@ -55,7 +55,7 @@ static void mavlink_common__wi(mavlink_common__w_t *w, int32_t v)
 static void mavlink_common__wf(mavlink_common__w_t *w, double v)
 {
     char t[40];
-    if (v != v) {
+    if (!(v >= 0.0 || v < 0.0)) { /* NaN (compared so, not v != v: clean under -Wfloat-equal) */
         mavlink_common__ws(w, "NaN");
     } else if (v > 1.7976931348623157e308) {
         mavlink_common__ws(w, "Infinity");

@@ -2473,7 +2473,7 @@ def json_writers(p: str) -> list[tuple[str, str]]:
     wf = f"""static void {p}__wf({p}__w_t *w, double v)
 {{
     char t[40];
-    if (v != v) {{
+    if (!(v >= 0.0 || v < 0.0)) {{ /* NaN (compared so, not v != v: clean under -Wfloat-equal) */
         {p}__ws(w, "NaN");
     }} else if (v > 1.7976931348623157e308) {{
         {p}__ws(w, "Infinity");

@@ -400,3 +400,7 @@ def test_a_spec_the_c_target_cannot_generate_is_refused_in_one_line_naming_the_f
     everything = serialspec("generate", "lamp.yaml", "--out", "all", cwd=tmp_path)
     assert everything.returncode == 0, everything.stderr
     assert (tmp_path / "all" / "tinylamp" / "__init__.py").is_file() and not (tmp_path / "all" / "c").exists()
+    # ... and says so, rather than leaving the user to wonder where the C went
+    assert everything.stderr.splitlines() == [
+        "lamp.yaml: no c output: the request frame: element length of type i8 (the other outputs are written)"
+    ]

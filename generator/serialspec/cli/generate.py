@@ -34,7 +34,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
-    files, errors = expected_files(proj, args.targets or (), bare=args.out is not None)
+    notes: list[str] = []  # targets that leave a spec out, and why
+    files, errors = expected_files(proj, args.targets or (), bare=args.out is not None, notes=notes)
     if proj.chosen and errors and all(path == proj.schema for path in files):
         # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
         for line in shown(errors):
@@ -63,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
             folder = folder.parent
     files_generated = f"{len(files)} file{'' if len(files) == 1 else 's'} generated"
     print(f"{files_generated} in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
+    for line in notes:
+        print(line, file=sys.stderr)
     for line in shown(errors):
         print(line, file=sys.stderr)
     return 1 if errors else 0

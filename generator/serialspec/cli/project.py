@@ -151,12 +151,13 @@ def _old_names(setting: object) -> frozenset[str]:
 
 
 def expected_files(
-    proj: Project, targets: Sequence[str] = (), *, bare: bool = False
+    proj: Project, targets: Sequence[str] = (), *, bare: bool = False, notes: list[str] | None = None
 ) -> tuple[dict[Path, str], list[SpecError]]:
     """Every generated file, by path, from the project's valid specs; and every mistake in the others. Given
     `targets` (emitter names), only those targets' files: no schema, no language reference; a spec a chosen target
     cannot generate is a mistake (the target's one-line reason). `bare`: each target's files without its folder under
-    the output folder (`generate --target c --out DIR` writes DIR/<protocol>/, not DIR/c/<protocol>/)."""
+    the output folder (`generate --target c --out DIR` writes DIR/<protocol>/, not DIR/c/<protocol>/). `notes` takes
+    a line for each target that leaves a spec out of a run of every target (its reason), for the user to see."""
     files: dict[Path, str] = {}
     folders = {}
     if bare:
@@ -199,6 +200,11 @@ def expected_files(
             if target in outputs.refused:
                 message = f"the {target} target cannot generate this spec: {outputs.refused[target]}"
                 errors.append(SpecError(proj.display(spec), 1, 1, "", message))
+        if notes is not None and not targets:
+            notes.extend(
+                f"{proj.display(spec)}: no {target} output: {reason} (the other outputs are written)"
+                for target, reason in sorted(outputs.refused.items())
+            )
         made.append(outputs)
     if (
         proj.reference is not None and not errors and not targets

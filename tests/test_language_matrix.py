@@ -1557,6 +1557,38 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         assert both.feed(package.encode(asked) + frame) == [asked, answer]
 
 
+def test_a_reply_of_values_alone_through_every_output() -> None:
+    """`values_only` on a text response (the dial's): the C target and the dissector, which read each line alone,
+    refuse it in one line; the reference shows the reply without its code; the package reads it with its request,
+    the simulator answers with it, and a stream of both directions takes it after its request."""
+    from serialspec.backends import Unsupported
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["dial"]["response"]["values_only"] = True
+    protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    files: dict[str, str] = {}
+    for emitter in emitters():
+        if emitter.name in ("c", "wireshark"):
+            with pytest.raises(Unsupported, match="a reply of values alone"):
+                emitter.files(protocol)
+            continue
+        emitted = emitter.files(protocol)
+        assert emitter.verify is None or emitter.verify(protocol, emitted) == []
+        files.update(emitted)
+    assert "its values alone: no code" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        asked = package.DialRequest(talker="A", level=7, note="hi")
+        [(_, frame)] = device.feed(package.encode(asked))
+        assert frame.startswith(b"#7;"), frame  # the values alone, the first one right after the start
+        answer = package.decode(frame, "response", None, asked)
+        assert (answer.level, answer.volts, answer.count, answer.note) == (7, 25, 8, "hi"), answer
+        assert package.encode(answer) == frame
+        both = package.StreamParser()
+        assert both.feed(package.encode(asked) + frame) == [asked, answer]
+
+
 def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
     """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value
     right after the code) beside the case's plain sentences: C and

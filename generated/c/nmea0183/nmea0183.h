@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "5dfa08c8d9422a87529a79454aa08bf394ed799cce87bbf493a86e4d9dbcc1ce"
+#define NMEA0183_SPEC_SHA256 "b8d48b01cec37652cb102a93eb32a9e4d3b081e0b6ad82fea3197523fec7e49a"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

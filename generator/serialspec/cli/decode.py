@@ -40,7 +40,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="needed where requests and responses share a header",
     )
     parser.add_argument("--units", action="store_true", help="engineering units and enum names, not raw values")
-    parser.add_argument("--request", metavar="HEX", help="the request a response answers (shows registers by name)")
+    parser.add_argument(
+        "--request",
+        metavar="HEX",
+        help="the request a response answers (shows registers by name; reads a text reply of values alone)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -58,17 +62,18 @@ def run(args: argparse.Namespace) -> int:
         )
     protocol, package = open_spec(args.spec)
     if protocol.text is not None:
-        if args.request or args.units:
-            raise SerialspecError(
-                "a text protocol's sentences carry no registers or scaled values: --request and --units are for "
-                "binary frames"
-            )
+        if args.units:
+            raise SerialspecError("a text protocol's sentences carry no scaled values: --units is for binary frames")
         from serialspec.cli import textframes
 
         if args.file:
             return replay(args, protocol, package)
         sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
-        return textframes.decode(protocol.name, package, sentences, args.json, args.direction)
+        reply = None  # with --request: the code of its reply, where that is its values alone
+        if args.request:
+            asked = package.decode(textframes.frame_of(package.FRAMING, args.request), "request")
+            reply = package.CODEC.reply_code(asked.CODE)
+        return textframes.decode(protocol.name, package, sentences, args.json, args.direction, reply)
     from serialspec.cli.views import message_spec
     from serialspec.lang.model import replies_by_request, reply_to
 

@@ -203,4 +203,13 @@ def _shown(protocol: Protocol, frame: bytes) -> str:
 
 def _text(message: object) -> str:
     what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")  # type: ignore[attr-defined]
-    return f"{what} {json.dumps(message.to_fields(), ensure_ascii=False)}"  # type: ignore[attr-defined]
+    values = message.to_fields()  # type: ignore[attr-defined]
+    return f"{what} {json.dumps(values, ensure_ascii=False, default=_plain)}"
+
+
+def _plain(value: object) -> object:
+    """A text message's value JSON has no type for: a letter (an Enum) as its letter, a decimal, time or date as
+    its text."""
+    from enum import Enum
+
+    return value.value if isinstance(value, Enum) else str(value)

@@ -31,10 +31,13 @@ def frame_of(framing: TextFraming, given: str) -> bytes:
         raise DecodeError(f"neither a sentence starting with {framing.start!r} nor hex: {exc}") from None
 
 
-def describe(protocol: str, package: ModuleType, frame: bytes, direction: str | None = None) -> dict[str, Any]:
-    """A frame of the text protocol named `protocol` as `decode --json` prints it (the package alone answers)."""
+def describe(
+    protocol: str, package: ModuleType, frame: bytes, direction: str | None = None, reply: str | None = None
+) -> dict[str, Any]:
+    """A frame of the text protocol named `protocol` as `decode --json` prints it (the package alone answers).
+    `reply`: the code of the reply awaited, where it is its values alone (`decode --request`)."""
     framing: TextFraming = package.FRAMING
-    sentence = framing.decode(frame, direction)
+    sentence = framing.decode(frame, direction, reply)
     cls = package.CODEC.classes[sentence.code, sentence.direction]
     body = frame.decode("ascii")
     return {
@@ -52,13 +55,21 @@ def describe(protocol: str, package: ModuleType, frame: bytes, direction: str | 
     }
 
 
-def decode(protocol: str, package: ModuleType, frames: list[str], as_json: bool, direction: str | None = None) -> int:
+def decode(
+    protocol: str,
+    package: ModuleType,
+    frames: list[str],
+    as_json: bool,
+    direction: str | None = None,
+    reply: str | None = None,
+) -> int:
     failed = 0
     for given in frames:
         try:
-            result = describe(protocol, package, frame_of(package.FRAMING, given), direction)
+            result = describe(protocol, package, frame_of(package.FRAMING, given), direction, reply)
         except (DecodeError, SerialspecError) as exc:
             hint = " (--direction request|response)" if isinstance(exc, DirectionNeeded) else ""
+            hint = " (--request SENTENCE)" if str(exc).endswith("give the request") else hint
             print(f"serialspec decode: {given.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue

@@ -554,6 +554,18 @@ MESSAGE = Obj(
         "text": TEXT_LAYOUT,
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
+        "values_only": Bool(
+            "Text frames, a response: the reply is its values alone, without its code (ODrive's ASCII protocol "
+            "answers `f 0` with `1.2340 0.5000`: `feedback: {code: f, request: {fields: {motor: integer}}, "
+            "response: {values_only: true, fields: {position: decimal, velocity: decimal}}}`; SCPI instruments "
+            "answer `MEAS:VOLT?` with `+1.234E+00`). It is read "
+            "as the reply to the request before it: `decode` refuses it without that request (`--request`), the "
+            "stream parser takes it while the request awaits its reply (the client's, or the request just read in a "
+            "stream of both directions), and the simulator answers with it. The C target and the dissector, which "
+            "read each line alone, refuse such a spec.",
+            default=False,
+            example=True,
+        ),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "

@@ -149,6 +149,7 @@ class TextSentence:
     #: "request" or "response": a code may name one message each way (a command and its answer)
     direction: str = "response"
     layout: TextLayout | None = None  # its own text inside the frame, where it has one
+    bare: bool = False  # a reply of its values alone, no code: read as the answer to the request before it
 
     @property
     def where(self) -> str:
@@ -213,7 +214,10 @@ class TextFraming:
         none, or where the code names two and no direction is given."""
         found = self.by_code.get(code)
         if not found:
-            raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+            hint = ""
+            if direction != "request" and any(s.bare for s in self.sentences):
+                hint = "; a reply of values alone is read with the request it answers: give the request"
+            raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)}){hint}")
         if len(found) == 1:  # the code says the direction (an answer-only code read by a request parser too)
             return next(iter(found.values()))
         if direction is None:
@@ -222,9 +226,11 @@ class TextFraming:
 
     # --- decoding --------------------------------------------------------------------------------------------------
 
-    def decode(self, frame: bytes | str, direction: str | None = None) -> Sentence:
+    def decode(self, frame: bytes | str, direction: str | None = None, reply: str | None = None) -> Sentence:
         """One frame (with or without its line ending) -> its sentence; DecodeError says in one line why not.
-        `direction` is needed only for a code that names a request and a response."""
+        `direction` is needed only for a code that names a request and a response. `reply`: the code of the reply
+        awaited (the answer to the request before this frame): where that reply is its values alone (`bare`), a
+        frame that does not start with another message's code is read as it."""
         text = _ascii(frame)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
@@ -238,9 +244,17 @@ class TextFraming:
         parts = body.split(self.separator)
         address = parts[0]
         talker, code = address[: self.talker], address[self.talker :]
+        if reply is not None and direction != "request":
+            bare = self.by_code.get(reply, {}).get("response")
+            if bare is not None and bare.bare and not self._coded(code):
+                return Sentence("", reply, _decode_fields(bare, parts), len(parts), "response")
         sentence = self.sentence(code, direction)
         values = _decode_fields(sentence, parts[1:])
         return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
+
+    def _coded(self, code: str) -> bool:
+        """Whether a frame's first field is the code of a message a device sends with its code."""
+        return any(not s.bare and s.direction == "response" for s in self.by_code.get(code, {}).values())
 
     def _decode_in(self, layout: TextLayout, inner: str, direction: str | None) -> Sentence:
         """A frame in a message's own layout (its start and end taken off)."""
@@ -297,7 +311,7 @@ class TextFraming:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
             parts = (parts + [""] * sent)[:sent]
-        body = self.separator.join([talker + code, *parts])
+        body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
         return self.frame(body)
 
     def frame(self, body: str) -> bytes:
@@ -694,6 +708,7 @@ class TextStreamParser:
         self.framing = framing
         self.direction = direction  # for codes that name a request and a response: which this stream carries
         self._asked: str | None = None  # the code of the request just read (both directions in one stream)
+        self._awaited: str | None = None  # the code of the reply awaited (expect), where it is values alone
         self._overlong = False  # frames without a start character: the line being read was dropped as too long
         self._start = framing.start.encode("ascii")
         self._end = framing.end.encode("ascii")
@@ -754,14 +769,22 @@ class TextStreamParser:
             except DecodeError as error:
                 self._dropped(str(error))
 
+    def expect(self, reply: str | None) -> None:
+        """The code of the reply the next frames answer (a client's request awaiting it; None: none): where that
+        reply is its values alone, a line that starts with no other message's code is read as it, once."""
+        self._awaited = reply
+
     def _decoded(self, frame: bytes) -> Sentence:
         """A frame's sentence. Both directions in one stream (a monitor's): a code that names a request and a
-        response is the response right after that request, the request otherwise."""
+        response is the response right after that request, the request otherwise; so is a reply of values alone."""
+        reply = self._awaited or self._asked
         try:
-            sentence = self.framing.decode(frame, self.direction)
+            sentence = self.framing.decode(frame, self.direction, reply)
         except DirectionNeeded as needed:
             direction = "response" if self._asked == needed.code else "request"
-            sentence = self.framing.decode(frame, direction)
+            sentence = self.framing.decode(frame, direction, reply)
+        if sentence.direction == "response" and sentence.code == self._awaited:
+            self._awaited = None  # answered: the next line is read by its own code again
         self._asked = sentence.code if sentence.direction == "request" else None
         return sentence
 
@@ -857,7 +880,7 @@ class TextCodec:
         self.answers = dict(answers or {})
         self._responses = {c: cls for (c, direction), cls in self.classes.items() if direction == "response"}
 
-    def replies(self, code: str) -> tuple[tuple[type, ...], tuple[type, ...]]:
+    def replies(self, code: str) -> tuple[tuple[type[TextRecord], ...], tuple[type[TextRecord], ...]]:
         """The response classes that answer a request of this code, and those that refuse it."""
         answering, refusing = self.answers.get(code, ((code,), ()))
         responses = self._responses
@@ -867,10 +890,20 @@ class TextCodec:
         cls = self.classes[sentence.code, sentence.direction]
         return cls.from_fields(sentence.values, sentence.talker, sentence.sent)
 
-    def decode(self, frame: bytes | str, direction: str | None = None) -> Any:
+    def decode(self, frame: bytes | str, direction: str | None = None, expect: Any = None, request: Any = None) -> Any:
         """One frame -> its message; DecodeError (ChecksumError) says in one line why not. `direction` ("request"
-        or "response") is needed only for a code that names both."""
-        return self.message(self.framing.decode(frame, direction))
+        or "response") is needed only for a code that names both. A reply of values alone (`values_only`) is read
+        as the answer to `request` (a message) or as `expect` (the reply class awaited)."""
+        reply = expect.CODE if expect is not None else self.reply_code(request.CODE) if request is not None else None
+        return self.message(self.framing.decode(frame, direction, reply))
+
+    def reply_code(self, code: str) -> str | None:
+        """The code of the reply of values alone that answers a request of this code, or None."""
+        for cls in self.replies(code)[0]:
+            sentence = self.framing.by_code.get(cls.CODE, {}).get("response")
+            if sentence is not None and sentence.bare:
+                return cls.CODE
+        return None
 
     def encode(self, message: TextRecord) -> bytes:
         """A message -> its frame; EncodeError (RangeError) names the field at fault before any text is written."""
@@ -977,17 +1010,21 @@ class TextClient:
         answers, refusals = self.CODEC.replies(message.CODE)
         if not answers:
             return None  # a command the device does not answer
-        deadline = time.monotonic() + timeout
-        while (left := deadline - time.monotonic()) > 0:
-            for arrived in self._arrived((yield min(left, 0.2))):
-                if isinstance(arrived, answers):
-                    return arrived
-                if isinstance(arrived, refusals):
-                    raise DeviceError(
-                        f"{message.COMMAND} ({message.CODE}): the device refused it: {arrived!r}", arrived
-                    )
-                self._unread.append(arrived)
-        raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+        self.parser.expect(self.CODEC.reply_code(message.CODE))  # a reply of values alone is read as the answer
+        try:
+            deadline = time.monotonic() + timeout
+            while (left := deadline - time.monotonic()) > 0:
+                for arrived in self._arrived((yield min(left, 0.2))):
+                    if isinstance(arrived, answers):
+                        return arrived
+                    if isinstance(arrived, refusals):
+                        raise DeviceError(
+                            f"{message.COMMAND} ({message.CODE}): the device refused it: {arrived!r}", arrived
+                        )
+                    self._unread.append(arrived)
+            raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+        finally:
+            self.parser.expect(None)
 
     def _arrived(self, data: bytes) -> list[Any]:
         messages = self.parser.feed(data)

@@ -141,6 +141,11 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
             sent += f", answered by the `{message.answered_by}` response"
         if message.refused_by:
             sent += f", refused by {' or '.join(f'the `{name}` response' for name in message.refused_by)}"
+        if message.values_only:
+            sent += (
+                f", its values alone: no code (the line after a `{message.code}` request is read as this reply, "
+                "its first field first)"
+            )
         yield f"`{message.class_name}`, {sent}." + (f" Source: {text(message.source)}." if message.source else "")
         yield ""
         if message.description:
@@ -174,24 +179,31 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         if layout is not None:  # its own text: shown whole (the fields above say how it is cut)
             yield f"| {code_span(example.printed)} | the message's own text |"
             continue
-        yield from _characters(frame, example.printed, example.fields)
+        bare = any(
+            m.values_only for m in frame.messages if m.key == example.command and m.direction == example.direction
+        )
+        yield from _characters(frame, example.printed, example.fields, bare)
     yield ""
     yield "## Errata"
     yield ""
     yield "None recorded (errata are not available in text frames yet)."
 
 
-def _characters(frame: TextFrame, printed: str, fields: dict[str, object]) -> Iterator[str]:
-    """The printed frame cut into its parts: start, talker, code, each field, checksum, end."""
+def _characters(frame: TextFrame, printed: str, fields: dict[str, object], bare: bool = False) -> Iterator[str]:
+    """The printed frame cut into its parts: start, talker, code, each field, checksum, end (`bare`: a reply of
+    values alone, its first part the first field)."""
     body = printed[len(frame.start) :]
     checksum = ""
     if frame.checksum is not None and frame.marker in body:
         body, checksum = body.rsplit(frame.marker, 1)
     parts = body.split(frame.separator)
+    if bare:
+        parts = ["", *parts]  # no code: the first part is a field's, written without a separator before it
     yield f"| {code_span(frame.start)} | start |"
-    if frame.talker:
+    if frame.talker and not bare:
         yield f"| {code_span(parts[0][: frame.talker])} | talker |"
-    yield f"| {code_span(parts[0][frame.talker :])} | code |"
+    if not bare:
+        yield f"| {code_span(parts[0][frame.talker :])} | code |"
     names = []
     for name, value in fields.items():
         if isinstance(value, list):
@@ -200,7 +212,8 @@ def _characters(frame: TextFrame, printed: str, fields: dict[str, object]) -> It
             names.append(name)
     for index, part in enumerate(parts[1:]):
         name = names[index] if index < len(names) else "?"
-        yield f"| {code_span(frame.separator + part)} | `{name}`{' (empty: None)' if not part else ''} |"
+        written = part if bare and index == 0 else frame.separator + part
+        yield f"| {code_span(written)} | `{name}`{' (empty: None)' if not part else ''} |"
     if checksum:
         yield f"| {code_span(frame.marker + checksum)} | checksum |"
     yield f"| {_shown(frame.end)} | end |"

@@ -48,7 +48,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield "from serialspec.runtime.text import TextMessageParser"
     yield ""
     used = {text.message(s.command).class_name for s in device.sends}
-    used |= {m.class_name for request, response, _ in answered for m in (request, response)}
+    used |= {m.class_name for request, response, _ in answered for m in (request, response) if m is not None}
     classes = sorted(used)
     yield f"from . import CODEC, {', '.join(['PROTOCOL', *classes])}"
     yield ""
@@ -66,9 +66,11 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     if answered:
         yield "    commands=("
         for request, response, answer in answered:
-            empty: dict[str, object] = {f.name: () if isinstance(f, TextRepeat) else None for f in response.fields}
+            replied = response.fields if response is not None else ()
+            empty: dict[str, object] = {f.name: () if isinstance(f, TextRepeat) else None for f in replied}
             empty |= {"talker": default_talker, "sent": -1}
-            args = [f"cast(Any, {request.class_name})", f"cast(Any, {response.class_name})"]
+            answering = f"cast(Any, {response.class_name})" if response is not None else "None"
+            args = [f"cast(Any, {request.class_name})", answering]
             if answer is not None and answer.stores:
                 args.append(f"stores={answer.stores!r}")
             if answer is not None and answer.sets:
@@ -111,16 +113,16 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield "    )"
 
 
-def _answered(text: TextFrame, device: TextDevice) -> list[tuple[TextMessage, TextMessage, TextAnswer | None]]:
-    """(request, response, the device's entry for it) of every command the device answers: each one with a
-    request and a response."""
+def _answered(text: TextFrame, device: TextDevice) -> list[tuple[TextMessage, TextMessage | None, TextAnswer | None]]:
+    """(request, response, the device's entry for it) of every command the device acts on: each one with a request
+    and a response, and each request without one that its entry stores or sets something from (no answer)."""
     entries = {a.command: a for a in device.commands}
-    found = []
+    found: list[tuple[TextMessage, TextMessage | None, TextAnswer | None]] = []
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
         response = text.answer(request)
-        if response is not None:
+        if response is not None or request.key in entries:
             found.append((request, response, entries.get(request.key)))
     return found
 
@@ -271,6 +273,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
                 f"{k}={getattr(message.layout, k)!r}" for k in ("start", "end", "separator", "named", "list")
             )
             yield f"            layout=TextLayout({shown}),"
+        if message.values_only:
+            yield "            bare=True,"
         yield "        ),"
     yield "    ),"
     yield ")"

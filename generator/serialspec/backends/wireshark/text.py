@@ -21,6 +21,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
+    if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
+        raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

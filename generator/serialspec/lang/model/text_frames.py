@@ -69,6 +69,7 @@ class TextMessage:
     answered_by: str = ""  # a request answered by another command's response (its key): GRBL's `ok`
     refused_by: tuple[str, ...] = ()  # commands whose responses refuse the request instead: GRBL's `error:N`
     layout: TextLayout | None = None  # its own text inside the frame (`text:`): GRBL's `<Idle|MPos:…>`
+    values_only: bool = False  # a reply of its values alone, no code: read as the answer to the request before it
 
 
 @frozen

@@ -612,6 +612,12 @@ class Commands(FieldResolver):
             self.error((*path, "error_reply"), "an error reply is a response")
         if "text" in value:
             self.error((*path, "text"), "`text` belongs to messages of text frames (`framing: {kind: text}`)")
+        if "values_only" in value:
+            self.error(
+                (*path, "values_only"),
+                "`values_only` belongs to text frames; a binary reply without a code is a command element that only "
+                "requests carry (`directions: [request]`)",
+            )
         return Message(
             command=command,
             subcommand=subcommand,

@@ -199,6 +199,15 @@ class TextPass(Pass):
             for item in fields:
                 if item.label:
                     self.error((*where, "fields", item.name, "label"), "a label needs `text: {named: ...}`")
+        values_only = bool(raw.get("values_only", False))
+        if values_only:
+            at = (*where, "values_only")
+            if direction != Direction.RESPONSE or "request" not in command:
+                self.error(at, "`values_only` belongs to a response, which its command's request gets")
+            elif raw.get("unsolicited"):
+                self.error(at, "a reply of values alone is read as the answer to its request: it is not unsolicited")
+            elif "text" in raw:
+                self.error(at, "a reply of values alone has no text layout of its own (`text:`)")
         class_name = camel(key, direction.value)
         self.class_name(class_name, where)
         return TextMessage(
@@ -214,6 +223,7 @@ class TextPass(Pass):
             answered_by=str(answered_by.get("command", "")),
             refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
             layout=layout,
+            values_only=values_only,
         )
 
     def layout(
@@ -411,9 +421,9 @@ class TextPass(Pass):
         for key, item in raw.items():
             where = (*path, str(key))
             request = frame.request(str(key))
-            response = frame.response(str(key))
-            if request is None or response is None:
-                self.error(where, f"{key!r} is not a command with a request and a response")
+            response = frame.answer(request) if request is not None else None
+            if request is None:
+                self.error(where, f"{key!r} is not a command with a request")
                 continue
             item = item or {}
             if not isinstance(item, dict):
@@ -422,8 +432,12 @@ class TextPass(Pass):
             for bad in item:
                 if bad not in ANSWER_KEYS:
                     self.error((*where, bad), f"`{bad}` is not available in a text protocol's device yet")
+                elif bad in ("reports", "echoes") and response is None:
+                    self.error(
+                        (*where, bad), f"{key!r} has no response: the device keeps what it is sent and answers nothing"
+                    )
             asked = {f.name for f in request.fields}
-            answered = {f.name for f in response.fields}
+            answered = {f.name for f in response.fields} if response is not None else set()
             stores = {}
             for name, variable in (item.get("stores") or {}).items():
                 if name not in asked:

@@ -382,3 +382,26 @@ def test_the_sim_logs_a_request_with_a_decimal(odrive: Any) -> None:
     assert _text(odrive.PositionRequest(motor=0, position=Decimal("2.5000"))) == (
         'position {"motor": 0, "position": "2.5000"}'
     )
+
+
+def test_a_capture_reads_each_reply_of_values_alone_after_its_request(
+    odrive: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`decode --file`: each direction's bytes are joined and split on their own; the request seen in one stream
+    makes the next line of the other its reply, however the reply's bytes are cut into chunks."""
+    from serialspec.cli import main as serialspec_main
+
+    spec = str(Path(odrive.__file__).parent.parent.parent / "odrive_ascii.yaml")
+    capture = tmp_path / "odrive.capture"
+    chunks = [("request", b"f 0\n"), ("response", b"1.5 0.0\n"), ("request", b"f 1\n"), ("response", b"2.5")]
+    chunks.append(("response", b"000 0.0\n"))
+    when = "2026-11-22T09:40:01.123456+00:00"
+    capture.write_text("".join(f"{when} {d} {data.hex(' ')}\n" for d, data in chunks), encoding="utf-8")
+    assert serialspec_main(["decode", spec, "--file", str(capture), "--json"]) == 0
+    shown = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(s["direction"], s["fields"]) for s in shown] == [
+        ("request", {"motor": "0"}),
+        ("response", {"position": "1.5", "velocity": "0.0"}),
+        ("request", {"motor": "1"}),
+        ("response", {"position": "2.5000", "velocity": "0.0"}),
+    ]

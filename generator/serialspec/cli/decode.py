@@ -173,12 +173,16 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
     failed = 0
     replies = replies_by_request(protocol.messages())
     asked: Message | None = None  # the last request seen
+    awaited: str | None = None  # text: the code of a reply of values alone that the last request gets
     stream = sys.stdin if args.file == "-" else capture.open_text(args.file)
     with stream:
         try:
             for number, chunk in capture.read(stream):
                 direction = chunk.direction or args.direction
                 frames = streams.get(direction) or streams.setdefault(direction, Frames(package, direction, address))
+                if text and direction == "response" and awaited is not None:
+                    frames.expect_text(awaited)  # the reply's own stream reads it as the answer, once
+                    awaited = None
                 for seen in frames.feed(chunk.data, number):
                     if seen.message is None:
                         failed += 1
@@ -186,7 +190,12 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                         continue
                     message, request = seen.message, None
                     if text:
-                        result = textframes.describe(protocol.name, package, seen.data, message.DIRECTION.value)
+                        code: str = getattr(message, "CODE")  # noqa: B009 (a text message; Frames types binary ones)
+                        if message.DIRECTION.value == "request" and direction == "request":
+                            awaited = package.CODEC.reply_code(code)
+                        sentence = package.FRAMING.sentence(code, message.DIRECTION.value)
+                        reply = code if sentence.bare else None  # a reply of values alone, read as one
+                        result = textframes.describe(protocol.name, package, seen.data, message.DIRECTION.value, reply)
                     else:
                         if message.DIRECTION.value == "request":
                             asked = message

@@ -61,6 +61,11 @@ class Frames:
         self._origins: list[tuple[int, object]] = []
         self._run: _Run | None = None
 
+    def expect_text(self, reply: str) -> None:
+        """A text protocol's reply of values alone (`values_only`) with this code answers the request just seen
+        in the other direction's stream: the next line is read as it."""
+        self._parser.expect(reply)
+
     def feed(self, chunk: bytes, origin: object = None) -> list[Seen]:
         """The frames and bad bytes that `chunk` completes, in stream order: each run of bad bytes once, as the
         bytes themselves, under the origin of the chunk its first byte came from (`de ad`, then a valid frame in

@@ -753,7 +753,12 @@ TABLE_ENTRY = Obj(
         "scale": Num("Engineering value = wire value × scale."),
         "range": RANGE,
         "default": OneOf((Num(), Str()), "The value after a reset: a number, or text when the document gives none."),
-        "access": Str("r (read-only) or rw (readable and writable).", choices=("r", "rw"), default="rw"),
+        "access": Str(
+            "r (read-only), rw (readable and writable), or w1c (readable; a write clears the bits written as 1 and "
+            "leaves the others: status flags a datasheet marks R+WC or W1C, as the TMC2209's GSTAT).",
+            choices=("r", "rw", "w1c"),
+            default="rw",
+        ),
         "memory": Str("Where the device keeps it: eeprom (kept over power-off) or sram.", choices=("eeprom", "sram")),
         "enum": Str("Name of an entry in `enums:`."),
         "flags": Str("Name of an entry in `flags:`."),

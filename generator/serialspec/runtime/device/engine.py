@@ -28,7 +28,7 @@ class EntrySpec:
     name: str
     key: int
     default: float
-    access: str  # "r" or "rw"
+    access: str  # "r", "rw" or "w1c" (a write clears the bits written as 1)
     minimum: float
     maximum: float
 
@@ -346,6 +346,14 @@ class VirtualDevice:
             self.state[name] = target
         else:
             self.memory[self.by_name[name].key] = target
+
+    def store(self, name: str, value: Any) -> None:
+        """A request's write of a memory entry: the value kept, or for a write-1-to-clear entry (`access: w1c`) the
+        bits written as 1 cleared and the others kept."""
+        entry = self.by_name.get(name)
+        if entry is not None and entry.access == "w1c":
+            value = int(self.get(name)) & ~int(value)
+        self.set(name, value)
 
     def writable(self, entry: EntrySpec | None, value: Any) -> bool:
         return not self.refusal(entry, value)
@@ -953,7 +961,7 @@ class Engine(FaultInjection):
         if any(reasons):
             return next((r for r in reasons if r and r != "out_of_range"), "out_of_range")
         for name, value in values.items():
-            device.set(name, value)
+            device.store(name, value)
         written.update(values)
         return ""
 
@@ -978,7 +986,7 @@ class Engine(FaultInjection):
             if reason:
                 return reason
             assert entry is not None
-            device.set(entry.name, given[name])
+            device.store(entry.name, given[name])
             return ""
         if table[:1] == ("block",):
             block = given[name]
@@ -987,9 +995,9 @@ class Engine(FaultInjection):
             if not reasons:
                 for n in table[1:]:
                     if device.by_name[n].access != "r":
-                        device.set(n, block[n])
+                        device.store(n, block[n])
             return next((r for r in reasons if r != "out_of_range"), reasons[0] if reasons else "")
-        device.set(name, packed(command.bit_fields.get(name), given[name]))
+        device.store(name, packed(command.bit_fields.get(name), given[name]))
         return ""
 
 

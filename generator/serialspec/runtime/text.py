@@ -246,15 +246,17 @@ class TextFraming:
         talker, code = address[: self.talker], address[self.talker :]
         if reply is not None and direction != "request":
             bare = self.by_code.get(reply, {}).get("response")
-            if bare is not None and bare.bare and not self._coded(code):
+            if bare is not None and bare.bare and not self._coded(code, direction):
                 return Sentence("", reply, _decode_fields(bare, parts), len(parts), "response")
         sentence = self.sentence(code, direction)
         values = _decode_fields(sentence, parts[1:])
         return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
 
-    def _coded(self, code: str) -> bool:
-        """Whether a frame's first field is the code of a message a device sends with its code."""
-        return any(not s.bare and s.direction == "response" for s in self.by_code.get(code, {}).values())
+    def _coded(self, code: str, direction: str | None) -> bool:
+        """Whether a frame's first field is the code of a message sent with its code, in `direction` (None: either;
+        a stream of both directions may hold a request that got no reply where its reply was awaited)."""
+        found = self.by_code.get(code, {}).values()
+        return any(not s.bare and direction in (None, s.direction) for s in found)
 
     def _decode_in(self, layout: TextLayout, inner: str, direction: str | None) -> Sentence:
         """A frame in a message's own layout (its start and end taken off)."""
@@ -781,7 +783,9 @@ class TextStreamParser:
         try:
             sentence = self.framing.decode(frame, self.direction, reply)
         except DirectionNeeded as needed:
-            direction = "response" if self._asked == needed.code else "request"
+            # a line with the code of the request just read is its answer, unless that answer is values alone
+            answer = self.framing.by_code[needed.code]["response"]
+            direction = "response" if self._asked == needed.code and not answer.bare else "request"
             sentence = self.framing.decode(frame, direction, reply)
         if sentence.direction == "response" and sentence.code == self._awaited:
             self._awaited = None  # answered: the next line is read by its own code again

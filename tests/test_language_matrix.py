@@ -860,8 +860,6 @@ CASES[BY_COMMAND] = Case(
         },
     },
 )
-# each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
-WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
 # Layouts chosen by command, one with a command element and one without (TFmini: configuration frames 42 57 02 00,
 # parameters, the command byte last; data frames 59 59 with no command): a codeless command travels in its own layout
 MIXED = "frame: layouts chosen by command, one without a command element, the command byte after the content"
@@ -896,7 +894,6 @@ CASES[MIXED] = Case(
         "measure": {"layout": "data", "request": {}, "response": {"fields": {"distance": "u16", "strength": "u16"}}},
     },
 )
-WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
 
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a

@@ -634,8 +634,10 @@ COMMAND = Obj(
             "frames told apart by their header (TFmini: data frames `59 59` with no command byte, `measurement: "
             "{layout: data}`, beside configuration frames `42 57 02 00`, parameters, the command byte last, "
             "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
-            "with no length, is found by trying each code's size. The C and Wireshark "
-            "targets, which read each frame alone, refuse such a spec in one line (`layouts chosen by command`).",
+            "with no length, is found by trying each code's size. The C decoder takes such a spec where each frame "
+            "says how to read it (replies through `p_decode_reply` with their request); the Wireshark dissector "
+            "reads a reply with the last request before it in the capture, and marks one whose request is not in "
+            "the capture (expert note `Request not in capture`).",
             example="read",
         ),
         "probe": Bool(
@@ -905,7 +907,8 @@ FRAME_ELEMENT = Obj(
             "in first, in this order, before the span it covers (RoboClaw: the reply CRC starts with the "
             "request's address and command, which the reply does not carry). Decoding such a reply needs its "
             "request: `decode` without one refuses it in one line (give `--request HEX`), the stream parser reads "
-            "such replies only while a request is pending (the client and the simulator have it).",
+            "such replies only while a request is pending (the client and the simulator have it); the Wireshark "
+            "dissector verifies it with the last request before it in the capture, and says when that is missing.",
             example=["address", "command"],
         ),
         "size": Int("optional: its size in bytes.", example=13),

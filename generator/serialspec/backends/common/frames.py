@@ -118,17 +118,6 @@ def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, .
     )
 
 
-def refuse_by_command(protocol: Protocol) -> None:
-    """Unsupported for frames read with the request they answer, in targets that take each frame alone (the C
-    decoder, the Wireshark dissector)."""
-    if protocol.framing.by_command:
-        raise Unsupported("layouts chosen by command (`layout:`)")
-    if protocol.framing.from_request:
-        raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
-    if protocol.framing.by_request(Direction.RESPONSE):
-        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
-
-
 def refuse_code_forms(protocol: Protocol) -> None:
     """Unsupported for a layout whose frames carry an expression of the command's code (`code:`) or a headerless
     layout beside headed ones, in a target that does not do them (the C decoder)."""

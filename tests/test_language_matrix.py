@@ -682,9 +682,6 @@ CASES["frame: layouts, a code only a later layout's command element holds"] = Ca
     },
     {"wide": {"code": 0x2002, "request": {"fields": {"w": "u16"}}, "response": {"fields": {"x": "i32"}}}},
 )
-C_REFUSES["frame: layouts, a code only a later layout's command element holds"] = (
-    "a command element that holds only some codes (layout v1)"
-)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},

@@ -996,7 +996,7 @@ FRAMING = Obj(
             "whose command element holds the code and whose length can count the frame (VESC: 02 + u8 length, 03 "
             "+ u16 length; MSP v1 `$M<`, u8 size, u8 command, XOR, beside v2 `$X<`, u16 command, u16 size, "
             "CRC-8/DVB-S2: a code above 255 is sent in v2, any other in v1; a code must fit one layout; the C "
-            "target refuses a command element that holds only some codes). They all have a command "
+            "encoder likewise sends a code in the first layout whose command element holds it). They all have a command "
             "element or none, unless each command names its layout (`layout:`). One layout may have no header if "
             "it starts with its command element: it takes every frame that starts with no other layout's header, "
             "and no code it sends may start as a header does (checked when the spec is read), so a frame is told "

@@ -125,8 +125,6 @@ def refuse_code_forms(protocol: Protocol) -> None:
     for layout, _ in layouts:
         if any(e.code for e in layout.elements if e.role == "command"):
             raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
-        if not protocol.framing.by_command and layout.has_command and held_codes(protocol, layout) is not None:
-            raise Unsupported(f"a command element that holds only some codes (layout {layout.name})")
     for layout, alternatives in layouts:
         if alternatives > 1 and not layout.header and not protocol.framing.by_command:
             raise Unsupported(f"a layout without a header beside layouts with one (layout {layout.name})")

@@ -999,12 +999,12 @@ FRAMING = Obj(
             "encoder likewise sends a code in the first layout whose command element holds it). They all have a "
             "command element or none, unless each command names its layout (`layout:`). One layout may have no "
             "header if it starts with its command element: it takes every frame that starts with no other "
-            "layout's header, and no code it sends may start as a header does (checked when the spec is read), so a frame is told "
-            "by its first bytes alone. Layouts that are the same in one direction are one layout there. The Pololu "
-            "Maestro's two forms of the same commands: `compact: {elements: {command: {role: command}, content: "
-            "{role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, value: AA}, command: "
-            '{role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 2E): both decode to '
-            "Set Target, a frame starting AA is the Pololu form (no command code is AA).",
+            "layout's header, and no code it sends may start as a header does (checked when the spec is read), so"
+            " a frame is told by its first bytes alone. Layouts that are the same in one direction are one layout"
+            " there. The Pololu Maestro's two forms of the same commands: `compact: {elements: {command: {role: "
+            "command}, content: {role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, "
+            'value: AA}, command: {role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 '
+            "2E): both decode to Set Target, a frame starting AA is the Pololu form (no command code is AA).",
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),

@@ -266,7 +266,8 @@ def result(
         "command": message.COMMAND,
         "subcommand": message.SUBCOMMAND,
         "fields": fields,
-        # a frame whose checksum fails does not decode; null where its direction's frames carry none
+        # a frame whose checksum fails does not decode; null where its direction's frames carry none (where layouts
+        # are chosen by command: where the message's layout carries none, RoboClaw's read requests)
         "checksum_ok": True if checksum else None,
         "hex": frame.hex(" "),
     }

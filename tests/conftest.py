@@ -164,13 +164,11 @@ def awaited(g: Generated, direction: Direction | None) -> st.SearchStrategy[tupl
     return st.sampled_from(specs).flatmap(lambda spec: st.tuples(st.just(message_class(g, spec)), requests(g, spec)))
 
 
-def refusal(g: Generated, target: str = "wireshark") -> str:
-    """What the targets that read each frame alone (Wireshark: backends/common/frames.py refuse_by_command; C:
-    backends/c/emit.py refuse_by_request, which takes layouts chosen by command where each frame says how to read it)
-    say when they refuse a spec whose replies are read with their request; "" for any other spec. Their suites check
-    that a refused spec gets exactly this one line, rather than leaving it out silently."""
-    if g.protocol.framing.by_command and target != "c":
-        return "layouts chosen by command (`layout:`)"
+def refusal(g: Generated) -> str:
+    """What the C target (backends/c/emit.py refuse_by_request) says when it refuses a spec whose replies are read
+    with their request; "" for any other spec. Its suite checks that a refused spec gets exactly this one line,
+    rather than leaving it out silently. (The Wireshark dissector reads such replies with the last request before
+    them in the capture.)"""
     if g.protocol.framing.from_request:
         return "a reply checksum over bytes of its request (`from_request`)"
     return ""

@@ -93,7 +93,7 @@ def test_a_shipped_spec_the_c_target_refuses_gets_one_line(g: Generated, tmp_pat
     line naming the feature, and writes nothing; one whose replies are read with their request (RoboClaw) is
     refused for exactly that (the C decoder reads each frame alone)."""
     reason = refused_in_one_line(g, "c", tmp_path / "refused")
-    assert reason == refusal(g, "c") if refusal(g, "c") else reason
+    assert reason == refusal(g) if refusal(g) else reason
 
 
 @cache

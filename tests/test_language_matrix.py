@@ -682,9 +682,6 @@ CASES["frame: layouts, a code only a later layout's command element holds"] = Ca
     },
     {"wide": {"code": 0x2002, "request": {"fields": {"w": "u16"}}, "response": {"fields": {"x": "i32"}}}},
 )
-C_REFUSES["frame: layouts, a code only a later layout's command element holds"] = (
-    "a command element that holds only some codes (layout v1)"
-)
 CASES["frame: truncate: trailing_zeros"] = Case(
     {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
     {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},
@@ -860,8 +857,6 @@ CASES[BY_COMMAND] = Case(
         },
     },
 )
-# each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
-WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
 # Layouts chosen by command, one with a command element and one without (TFmini: configuration frames 42 57 02 00,
 # parameters, the command byte last; data frames 59 59 with no command): a codeless command travels in its own layout
 MIXED = "frame: layouts chosen by command, one without a command element, the command byte after the content"
@@ -896,7 +891,6 @@ CASES[MIXED] = Case(
         "measure": {"layout": "data", "request": {}, "response": {"fields": {"distance": "u16", "strength": "u16"}}},
     },
 )
-WIRESHARK_REFUSES[MIXED] = "layouts chosen by command (`layout:`)"
 
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated, examples, refusal, refused_in_one_line
+from conftest import ALL, ROOT, Generated, examples, requests
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from serialspec import cli
@@ -45,8 +45,9 @@ TSHARK = shutil.which("tshark")
 SERIALSPEC = [sys.executable, "-m", "serialspec"]
 
 
-# the specs the Wireshark target takes (one it refuses gets its one line: see refusal())
-DISSECTED = [g for g in ALL if not refusal(g)]
+# the specs the Wireshark target takes: every shipped one (replies read with their request, RoboClaw's, with the last
+# request before them in the capture)
+DISSECTED = ALL
 
 
 def run(*args: str) -> str:
@@ -55,22 +56,41 @@ def run(*args: str) -> str:
     return done.stdout
 
 
-def decoded(protocol: Protocol, direction: str, frames: list[bytes]) -> list[dict[str, Any]]:
-    """`serialspec decode SPEC --json --direction D HEX...`, run in this process (the CLI's own code)."""
+def decoded(protocol: Protocol, direction: str, frames: list[bytes], request: bytes = b"") -> list[dict[str, Any]]:
+    """`serialspec decode SPEC --json --direction D [--request HEX] HEX...`, run in this process (the CLI's own
+    code)."""
     spec = str(ROOT / protocol.spec_path)
     out = io.StringIO()
+    asked = ["--request", request.hex(" ")] if request else []
     with contextlib.redirect_stdout(out):
-        assert cli.main(["decode", spec, "--json", "--direction", direction, *(f.hex(" ") for f in frames)]) == 0
+        assert (
+            cli.main(["decode", spec, "--json", "--direction", direction, *asked, *(f.hex(" ") for f in frames)]) == 0
+        )
     return [json.loads(line) for line in out.getvalue().splitlines()]
 
 
 def example_frames(protocol: Protocol) -> dict[str, list[bytes]]:
-    """Every example frame of the spec by direction, those the codec decodes (erratum examples as printed do not)."""
+    """Every example frame of the spec by direction, those the codec decodes (erratum examples as printed do not);
+    not the replies read with their request (see answered_examples)."""
     frames: dict[str, list[bytes]] = {"request": [], "response": []}
     for example in protocol.examples:
-        if not example.erratum and example.frame not in frames[example.direction.value]:
+        if example.erratum or (example.direction.value == "response" and protocol.framing.requesting):
+            continue
+        if example.frame not in frames[example.direction.value]:
             frames[example.direction.value].append(example.frame)
     return frames
+
+
+def answered_examples(protocol: Protocol) -> list[tuple[bytes, bytes]]:
+    """(request, reply) of each example reply read with the request it answers (its `request:` example)."""
+    frames = {example.name: example.frame for example in protocol.examples}
+    found = [
+        (frames[example.request], example.frame)
+        for example in protocol.examples
+        if example.direction.value == "response" and protocol.framing.requesting and not example.erratum
+    ]
+    assert all(request for request, _ in found), "an example reply read with its request names no request"
+    return found
 
 
 def pdml_frames(xml: str) -> list[ET.Element]:
@@ -107,7 +127,7 @@ def value(field: Field, shown: ET.Element, abbr: str) -> Any:
                 return [item.get("show") == "1" for item in items]
             return [number(item.get("show") or "") for item in items]
         case Text():
-            return shown.get("show")
+            return text_of(field, shown)
         case Bytes():
             data = bytes.fromhex(shown.get("value") or "")
             return data.hex(" ")
@@ -118,6 +138,17 @@ def value(field: Field, shown: ET.Element, abbr: str) -> Any:
         case TableBlock():
             return {e.name: number(child(shown, f"{abbr}.{e.name}").get("show") or "") for e in field.entries}
     raise AssertionError(field)
+
+
+def text_of(field: Text, shown: ET.Element) -> str:
+    """A text as shown; where it holds a line break or a tab, as its bytes say (XML reads those in an attribute as
+    spaces)."""
+    text = shown.get("show") or ""
+    raw = bytes.fromhex(shown.get("value") or "")
+    raw = raw[:-1] if field.size is None else raw  # (a NUL-terminated text: its NUL)
+    raw = raw.rstrip(bytes([field.pad])) if field.pad is not None else raw
+    exact = raw.decode("latin-1")
+    return exact if not field.seven_bit and exact.translate({9: 32, 10: 32, 13: 32}) == text else text
 
 
 def fields_of(fields: tuple[Field, ...], tree: ET.Element, prefix: str) -> dict[str, Any]:
@@ -196,6 +227,14 @@ def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) ->
                 moment += datetime.timedelta(milliseconds=1)
                 capture.append(f"{moment.isoformat(timespec='microseconds')} {direction} {data.hex(' ')}")
             wanted += [{"protocol": protocol.name, **r} for r in results] * 2
+        for request, reply in answered_examples(protocol):  # each reply after its request, read with it
+            for direction, data, results in (
+                ("request", request, decoded(protocol, "request", [request])),
+                ("response", reply, decoded(protocol, "response", [reply], request)),
+            ):
+                moment += datetime.timedelta(milliseconds=1)
+                capture.append(f"{moment.isoformat(timespec='microseconds')} {direction} {data.hex(' ')}")
+                wanted += [{"protocol": protocol.name, **r} for r in results]
         path = tmp_path / f"{protocol.name}.capture"
         path.write_text("\n".join(capture) + "\n", encoding="utf-8")
         captures.append(str(path))
@@ -308,9 +347,6 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
     in one capture: tshark shows what the codec decodes."""
     assert TSHARK is not None
     protocol = g.protocol
-    if refusal(g):  # replies read with their request (RoboClaw): a dissector sees each frame alone
-        assert refused_in_one_line(g, "wireshark", tmp_path / "refused") == refusal(g)
-        return
     run(*SERIALSPEC, "generate", str(ROOT / protocol.spec_path), "--target", "wireshark", "--out", str(tmp_path))
     script = f"lua_script:{tmp_path / protocol.name / f'{protocol.name}.lua'}"
     specs = [m for m in protocol.messages() if not m.unsolicited or m.direction.value == "response"]
@@ -329,8 +365,17 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
         wanted = []
         for spec in specs * 2:
             cls = next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
-            frame = g.package.encode(cls.from_fields(data.draw(message_fields(protocol, spec), label=spec.key)))
-            message = g.package.decode(frame, spec.direction.value)  # as a frame without its request decodes
+            request = data.draw(requests(g, spec), label=f"{spec.key} answers")
+            if request is not None:  # a reply read with its request: the request before it in the capture
+                asked = g.package.encode(request)
+                wanted.append(describe(protocol, g.package.decode(asked, "request"), asked, False, None))
+                lines.append(f"2026-11-25T10:00:00.000000+00:00 request {asked.hex(' ')}")
+            message = cls.from_fields(data.draw(message_fields(protocol, spec), label=spec.key))
+            frame = g.package.encode(message) if request is None else g.package.encode(message, request)
+            if request is None:
+                message = g.package.decode(frame, spec.direction.value)  # as a frame without its request decodes
+            else:
+                message = g.package.decode(frame, spec.direction.value, request=request)
             wanted.append(describe(protocol, message, frame, False, None))
             lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
         (tmp_path / "random.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -375,11 +420,23 @@ def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False, twic
             captures, wanted = [], []
             for protocol, package in built:
                 lines = [f"# serialspec capture: {protocol.name}"]
+                g = Generated(protocol, package, package)
                 for spec in protocol.messages():
                     cls = next(c for c in package.MESSAGE_TYPES if c.__name__ == spec.class_name)
                     fields = data.draw(message_fields(protocol, spec), label=f"{protocol.title} {spec.key}")
-                    frame = package.encode(cls.from_fields(fields))
-                    message = package.decode(frame, spec.direction.value)
+                    request = data.draw(requests(g, spec), label=f"{protocol.title} {spec.key} answers")
+                    if request is not None:  # a reply read with its request: the request before it in the capture
+                        asked = package.encode(request)
+                        wanted.append(
+                            (protocol, describe(protocol, package.decode(asked, "request"), asked, False, None))
+                        )
+                        lines.append(f"2026-11-25T10:00:00.000000+00:00 request {asked.hex(' ')}")
+                    if request is None:
+                        frame = package.encode(cls.from_fields(fields))
+                        message = package.decode(frame, spec.direction.value)
+                    else:
+                        frame = package.encode(cls.from_fields(fields), request)
+                        message = package.decode(frame, spec.direction.value, request=request)
                     wanted.append((protocol, describe(protocol, message, frame, False, None)))
                     if twice:
                         wanted.append(wanted[-1])
@@ -491,3 +548,52 @@ def test_tshark_reads_both_forms_of_the_same_commands(tmp_path: Path) -> None:
     run(*SERIALSPEC, "export", str(bad), "--pcap", str(tmp_path / "bad.pcap"))
     said = run(TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-V")
     assert "Bytes outside any frame: aa" in said and "request set_target" in said, said
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_reads_a_reply_with_the_request_before_it(tmp_path: Path) -> None:
+    """RoboClaw's replies carry no code and their CRC starts with the request's address and command: a reply before
+    any request is one clear note (not garbage, not a guess); after its request it is read in the request's layout,
+    its CRC verified over the request's bytes (a wrong one flagged), a write's bare 0xFF read as its acknowledgement."""
+    assert TSHARK is not None
+    spec = str(ROOT / "specs" / "roboclaw.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "asked.capture"
+    capture.write_text(
+        "# serialspec capture: roboclaw\n"
+        "2026-11-25T10:00:00.000000+00:00 response 00 78 c8 65\n"
+        "2026-11-25T10:00:00.000100+00:00 request 80 18\n"
+        "2026-11-25T10:00:00.000200+00:00 response 00 78 c8 66\n"
+        "2026-11-25T10:00:00.000300+00:00 request 81 18\n"  # another address: another CRC
+        "2026-11-25T10:00:00.000400+00:00 response 00 78 c8 65\n"
+        "2026-11-25T10:00:00.000500+00:00 request 80 20 c0 00 4d aa\n"
+        "2026-11-25T10:00:00.000600+00:00 response ff\n",
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "asked.pcap"))
+    script = f"lua_script:{tmp_path / 'roboclaw' / 'roboclaw.lua'}"
+    out = run(TSHARK, "-X", script, "-r", str(tmp_path / "asked.pcap"), "-V")
+    assert "4 byte(s) read in the layout of the request they answer; the request is not in the capture" in out
+    assert "[Request not in capture]" in out
+    assert out.count("crc: 0xc866 [incorrect, should be 0xc865]") == 1
+    assert out.count("crc: 0xc865 [incorrect, should be ") == 1  # (81 18 gives another CRC)
+    fields = [
+        "-e",
+        "roboclaw.command",
+        "-e",
+        "roboclaw.read_main_battery.response.voltage",
+        "-e",
+        "roboclaw.checksum_ok",
+    ]
+    shown = run(TSHARK, "-X", script, "-r", str(tmp_path / "asked.pcap"), "-T", "fields", *fields)
+    assert shown.splitlines() == [
+        "\t\t",
+        "read_main_battery\t\t",
+        "read_main_battery\t120\t0",
+        "read_main_battery\t\t",
+        "read_main_battery\t120\t0",
+        "duty_m1\t\t1",
+        "duty_m1\t\t",
+    ], shown

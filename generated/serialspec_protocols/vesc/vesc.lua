@@ -114,6 +114,7 @@ local LAYOUTS = {
         description = "End of packet.",
       },
     },
+    name = "short",
   },
   {
     elements = {
@@ -177,6 +178,7 @@ local LAYOUTS = {
         description = "End of packet.",
       },
     },
+    name = "long",
   },
 }
 
@@ -1107,6 +1109,26 @@ for _, direction in pairs(SPEC.directions) do
     end
     layout.after[last] = offset
     layout.suffix = offset
+    -- a command element after the content, nothing else to size the frame by (no length, stuffing or trailer): each
+    -- code's frame size (a content of one size per code), smallest first, the code as sent (runtime/framing.py
+    -- _trailing_codes)
+    local final = layout.elements[#layout.elements]
+    for index, element in ipairs(layout.elements) do
+      if element.role == "command" and index > last and not layout.transparency and final.role ~= "trailer" then
+        local sent = {}
+        for wire, code in pairs(element.wire or {}) do sent[code] = wire end
+        local sizes = {}
+        for code, entry in pairs(direction.codes) do
+          if type(code) == "number" and entry.min == entry.max and (not layout.codes or layout.codes[code])
+            and (not element.wire or sent[code]) then
+            sizes[#sizes + 1] = {size = layout.overhead + entry.min, wire = sent[code] or code, entry = entry}
+          end
+        end
+        table.sort(sizes, function(a, b) return a.size < b.size or (a.size == b.size and a.wire < b.wire) end)
+        layout.trailing = {index = index, sizes = sizes}
+      end
+      if element.role == "length" then layout.trailing = nil; break end
+    end
   end
   for _, entry in pairs(direction.codes) do
     if entry.message then
@@ -1119,14 +1141,19 @@ for _, direction in pairs(SPEC.directions) do
       declare_message(message)
     end
   end
+  for _, entry in pairs(direction.answers or {}) do
+    declare_message(entry.message)
+  end
 end
 
 local e_checksum = ProtoExpert.new(P .. ".checksum.bad", "Bad checksum", expert.group.CHECKSUM, expert.severity.ERROR)
 local e_malformed = ProtoExpert.new(P .. ".malformed", "Malformed frame", expert.group.MALFORMED, expert.severity.ERROR)
 local e_garbage = ProtoExpert.new(P .. ".garbage.bytes", "Bytes outside any frame", expert.group.PROTOCOL,
   expert.severity.WARN)
+local e_request = ProtoExpert.new(P .. ".request.missing", "Request not in capture", expert.group.SEQUENCE,
+  expert.severity.NOTE)
 proto.fields = all
-proto.experts = {e_checksum, e_malformed, e_garbage}
+proto.experts = {e_checksum, e_malformed, e_garbage, e_request}
 
 -- --- checksums and byte stuffing ------------------------------------------------------------------------------------
 
@@ -1520,6 +1547,7 @@ end
 local function entry_of(direction, code, layout)
   if layout.error then return direction.codes.error end -- an error header's layout: the error reply
   if code == nil then return direction.codes.none end
+  if layout.codes and not layout.codes[code] then return nil end -- layouts chosen by command: sent in another
   if direction.error_flag and band(code, direction.error_flag) ~= 0 then return direction.codes.error end
   return direction.codes[code]
 end
@@ -1535,9 +1563,19 @@ local function outside_limits(element, value)
   return element.limits ~= nil and (value < element.limits[1] or value > element.limits[2])
 end
 
+-- The bytes of the request a reply's checksum takes in first (`from_request`): "" for other checksums, nil when
+-- the request is not known (not in the capture before the reply).
+local function requested(element, request)
+  if element.request == nil then return "" end
+  if request == nil then return nil end
+  local parts = {}
+  for _, name in ipairs(element.request) do parts[#parts + 1] = request.parts[name] or "" end
+  return table.concat(parts)
+end
+
 -- Whether `frame`, of an untransformed `layout`, has its constants and checksums right (each element's bytes found
 -- from the frame's start before the content, from its end after it).
-local function frame_checks(layout, frame)
+local function frame_checks(layout, frame, request)
   local parts = {}
   for index, element in ipairs(layout.elements) do
     if layout.before[index] and index < layout.first then
@@ -1551,8 +1589,8 @@ local function frame_checks(layout, frame)
   end
   for index, element in ipairs(layout.elements) do
     if element.constant and parts[index] ~= element.constant then return false end
-    if element.role == "checksum" and not element.checksum.unverified then
-      local covered = table.concat(parts, "", element.span[1], element.span[2])
+    if element.role == "checksum" and not element.checksum.unverified and requested(element, request) then
+      local covered = requested(element, request) .. table.concat(parts, "", element.span[1], element.span[2])
       if checksum(element.checksum, element.size, covered) ~= unsigned(parts[index], element.big) then return false end
     end
   end
@@ -1560,8 +1598,12 @@ local function frame_checks(layout, frame)
 end
 
 -- The size of a frame of `layout` at data[pos], nil when none starts there, false when the packet ends first.
-local function frame_size(direction, layout, data, pos)
+-- `request`: the last request before it ({message, parts}), nil when none is known; replies that carry no code
+-- (`answers`) are read in the layout of the reply it gets.
+local function frame_size(direction, layout, data, pos, request)
   local available = #data - pos + 1
+  local answer = direction.answers and request and direction.answers[request.message.answer]
+  if answer and answer.layout ~= layout.name then return nil end
   local entry
   for index = 1, layout.first - 1 do
     local element, offset = layout.elements[index], layout.before[index]
@@ -1583,7 +1625,18 @@ local function frame_size(direction, layout, data, pos)
   for _, element in ipairs(layout.elements) do
     has_command = has_command or element.role == "command"
   end
-  if not has_command then entry = direction.codes.none end
+  if not has_command then entry = answer or direction.codes.none end
+  if layout.trailing and entry == nil then -- the command after the content: the smallest frame whose code fits
+    local element = layout.elements[layout.trailing.index]
+    for _, candidate in ipairs(layout.trailing.sizes) do
+      if available < candidate.size then return false end
+      local at = pos + candidate.size - layout.after[layout.trailing.index] - element.size
+      if unsigned(data:sub(at, at + element.size - 1), element.big) == candidate.wire then
+        return candidate.size, candidate.entry
+      end
+    end
+    return nil
+  end
   local inner = layout.inner_length
   if inner then -- a length of plain bytes within the transformed span: read through the transform
     local t, element = layout.transparency, layout.elements[inner.index]
@@ -1640,7 +1693,7 @@ local function frame_size(direction, layout, data, pos)
     local stop = data:find(final.constant, pos + layout.overhead - #final.constant, true)
     while stop do
       local size = stop + #final.constant - pos
-      if frame_checks(layout, data:sub(pos, pos + size - 1)) then return size, entry end
+      if frame_checks(layout, data:sub(pos, pos + size - 1), request) then return size, entry end
       stop = data:find(final.constant, stop + 1, true)
     end
     return false
@@ -1690,7 +1743,7 @@ local function decode_content(message, range, length, tree)
   end
 end
 
-local function dissect_frame(direction_name, direction, layout, entry, tvb, data, pos, size, tree, info)
+local function dissect_frame(direction_name, direction, layout, entry, tvb, data, pos, size, tree, info, request)
   local frame = data:sub(pos, pos + size - 1)
   local elements = layout.elements
   local root = tree:add(proto, tvb(pos - 1, size))
@@ -1799,10 +1852,15 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
             element.name, value, counted))
         end
       elseif role == "checksum" then
-        checked = true
-        local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
-          covered_by(layout, plain, stuffed, element))
-        if not expected then
+        local before = requested(element, request)
+        checked = checked or before ~= nil
+        local expected = not element.checksum.unverified and before and checksum(element.checksum, element.size,
+          before .. covered_by(layout, plain, stuffed, element))
+        if before == nil then -- it starts with bytes of the request, which the capture does not hold
+          item:append_text(" [not verified: it covers the request's " .. table.concat(element.request, " and ")
+            .. ", and the request is not in the capture]")
+          item:add_proto_expert_info(e_request)
+        elseif not expected then
           item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
             .. "]")
         elseif expected == value then
@@ -1819,14 +1877,22 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     root:add(f_checksum_ok, tvb(pos - 1, size), ok)
   end
   info[#info + 1] = title .. (ok and "" or " [bad checksum]") .. (malformed and " [malformed]" or "")
+  local parts = {} -- every element's bytes by name (what a reply's checksum over the request takes in)
+  for index, element in ipairs(elements) do parts[element.name] = plain[index] end
+  return {message = message, parts = parts}
 end
 
 -- A frame cut between packets (a port gives bytes in chunks) is shown whole in the packet that completes it: the
 -- bytes of the incomplete frame at the end of a packet go before the next packet of the same direction.
 local carried = {} -- packet number -> the bytes of an incomplete frame the packets before it left
 local pending = {} -- direction -> the incomplete frame at the end of the last packet of that direction
+-- A reply read with the request it answers (its layout, or a checksum over bytes of the request): the last request
+-- before it in the capture (as `serialspec decode --request` takes it), kept per packet on the first pass
+-- (Wireshark dissects packets again, in any order).
+local asked = {} -- packet number -> the last request before it ({message, parts}; nil: none yet)
+local last_request = nil
 function proto.init()
-  carried, pending = {}, {}
+  carried, pending, asked, last_request = {}, {}, {}, nil
 end
 local MOST_CARRIED = 65536
 
@@ -1835,7 +1901,9 @@ local function dissect(tvb, pinfo, tree, direction_code)
   if not pinfo.visited then
     carried[pinfo.number] = pending[direction_code]
     pending[direction_code] = nil
+    asked[pinfo.number] = last_request
   end
+  local request = asked[pinfo.number]
   local data = tvb:raw()
   if carried[pinfo.number] then
     data = carried[pinfo.number] .. data
@@ -1851,12 +1919,28 @@ local function dissect(tvb, pinfo, tree, direction_code)
     local found, incomplete = false, false
     for _, name in ipairs(names) do
       local direction = SPEC.directions[name]
+      local unread = direction and direction.answers and #direction.layouts > 1 and #names == 1
+      if unread and not (request and direction.answers[request.message.answer]) then
+        -- replies that carry no code, whose request is not in the capture: nothing says how to read them
+        local item = tree:add(proto, tvb(pos - 1))
+        item:set_text(string.format("%s %s: %d byte(s) read in the layout of the request they answer; the request"
+          .. " is not in the capture", SPEC.title, name, #data - pos + 1))
+        item:add_proto_expert_info(e_request)
+        info[#info + 1] = "request not in capture"
+        pinfo.cols.info = table.concat(info, ", ")
+        return
+      end
       for _, layout in ipairs(direction and direction.layouts or {}) do
-        local size, entry = frame_size(direction, layout, data, pos)
+        local size, entry = frame_size(direction, layout, data, pos, request)
         if size == false or (size and pos + size - 1 > #data) then
           incomplete = true
         elseif size and size >= layout.overhead and size > 0 then
-          local done, problem = pcall(dissect_frame, name, direction, layout, entry, tvb, data, pos, size, tree, info)
+          local done, problem = pcall(dissect_frame, name, direction, layout, entry, tvb, data, pos, size, tree, info,
+            request)
+          if done and name == "request" then -- the request the replies after it answer
+            request = problem
+            if not pinfo.visited then last_request = problem end
+          end
           if not done then
             local item = tree:add(proto, tvb(pos - 1, size))
             item:set_text(string.format("%s %s frame: %s", SPEC.title, name, tostring(problem)))

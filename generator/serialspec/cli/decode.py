@@ -251,7 +251,7 @@ def _has_checksum(protocol: Protocol, direction: str) -> bool:
 def describe(
     protocol: Protocol, message: Message, frame: bytes, units: bool, request: Message | None
 ) -> dict[str, Any]:
-    from serialspec.cli.views import engineering, register_view, unit_symbols
+    from serialspec.cli.views import engineering, message_spec, register_view, unit_symbols
 
     fields = message.to_fields()
     symbols = {}
@@ -259,6 +259,8 @@ def describe(
         fields = engineering(protocol, message, fields)
         symbols = unit_symbols(protocol, message)
     checksum = _has_checksum(protocol, message.DIRECTION.value)
+    if protocol.framing.by_command:  # layouts chosen by command: whether the message's own layout carries one
+        checksum = bool(protocol.layout(message_spec(protocol, message)).checksums)
     return result(protocol.name, message, frame, fields, checksum, register_view(protocol, message, request), symbols)
 
 
@@ -278,7 +280,8 @@ def result(
         "command": message.COMMAND,
         "subcommand": message.SUBCOMMAND,
         "fields": fields,
-        # a frame whose checksum fails does not decode; null where its direction's frames carry none
+        # a frame whose checksum fails does not decode; null where its direction's frames carry none (where layouts
+        # are chosen by command: where the message's layout carries none, RoboClaw's read requests)
         "checksum_ok": True if checksum else None,
         "hex": frame.hex(" "),
     }

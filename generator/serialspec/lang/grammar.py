@@ -669,8 +669,10 @@ COMMAND = Obj(
             "frames told apart by their header (TFmini: data frames `59 59` with no command byte, `measurement: "
             "{layout: data}`, beside configuration frames `42 57 02 00`, parameters, the command byte last, "
             "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
-            "with no length, is found by trying each code's size. The C and Wireshark "
-            "targets, which read each frame alone, refuse such a spec in one line (`layouts chosen by command`).",
+            "with no length, is found by trying each code's size. The C decoder takes such a spec where each frame "
+            "says how to read it (replies through `p_decode_reply` with their request); the Wireshark dissector "
+            "reads a reply with the last request before it in the capture, and marks one whose request is not in "
+            "the capture (expert note `Request not in capture`).",
             example="read",
         ),
         "probe": Bool(
@@ -946,7 +948,8 @@ FRAME_ELEMENT = Obj(
             "in first, in this order, before the span it covers (RoboClaw: the reply CRC starts with the "
             "request's address and command, which the reply does not carry). Decoding such a reply needs its "
             "request: `decode` without one refuses it in one line (give `--request HEX`), the stream parser reads "
-            "such replies only while a request is pending (the client and the simulator have it).",
+            "such replies only while a request is pending (the client and the simulator have it); the Wireshark "
+            "dissector verifies it with the last request before it in the capture, and says when that is missing.",
             example=["address", "command"],
         ),
         "size": Int("optional: its size in bytes.", example=13),
@@ -1034,15 +1037,15 @@ FRAMING = Obj(
             "whose command element holds the code and whose length can count the frame (VESC: 02 + u8 length, 03 "
             "+ u16 length; MSP v1 `$M<`, u8 size, u8 command, XOR, beside v2 `$X<`, u16 command, u16 size, "
             "CRC-8/DVB-S2: a code above 255 is sent in v2, any other in v1; a code must fit one layout; the C "
-            "target refuses a command element that holds only some codes). They all have a command "
-            "element or none, unless each command names its layout (`layout:`). One layout may have no header if "
-            "it starts with its command element: it takes every frame that starts with no other layout's header, "
-            "and no code it sends may start as a header does (checked when the spec is read), so a frame is told "
-            "by its first bytes alone. Layouts that are the same in one direction are one layout there. The Pololu "
-            "Maestro's two forms of the same commands: `compact: {elements: {command: {role: command}, content: "
-            "{role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, value: AA}, command: "
-            '{role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 2E): both decode to '
-            "Set Target, a frame starting AA is the Pololu form (no command code is AA).",
+            "encoder likewise sends a code in the first layout whose command element holds it). They all have a "
+            "command element or none, unless each command names its layout (`layout:`). One layout may have no "
+            "header if it starts with its command element: it takes every frame that starts with no other "
+            "layout's header, and no code it sends may start as a header does (checked when the spec is read), so"
+            " a frame is told by its first bytes alone. Layouts that are the same in one direction are one layout"
+            " there. The Pololu Maestro's two forms of the same commands: `compact: {elements: {command: {role: "
+            "command}, content: {role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, "
+            'value: AA}, command: {role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 '
+            "2E): both decode to Set Target, a frame starting AA is the Pololu form (no command code is AA).",
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),

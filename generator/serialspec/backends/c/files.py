@@ -446,9 +446,10 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
 def chosen_functions(ctx: Ctx) -> str:
     """Layouts chosen by command (`layout:`): which codes each layout sends ({p}__sends), and whether a frame carries,
     at its layout's fixed command offset, a code that layout sends ({p}__sends_at: runtime/framing.py _code_at, for
-    FrameCodec.unwrap's choice of whose refusal counts). "" for other protocols."""
+    FrameCodec.unwrap's choice of whose refusal counts); where a layout's command element holds only some codes
+    (MSP v1's u8 beside v2's u16), {p}__sends alone, for the probe. "" for other protocols."""
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
-    if not protocol.framing.by_command:
+    if not any(layout_codes(protocol, layout) is not None for layout in every_layout(protocol)):
         return ""
     sends: list[str] = []
     at: list[str] = []
@@ -469,6 +470,20 @@ def chosen_functions(ctx: Ctx) -> str:
                     f"    if (dir == {P}_{d.name} && k == {k}u) {{\n"
                     f"        return n >= {offset + (e.size or 0)}u && {p}__sends(dir, k, (long)({value}));\n    }}"
                 )
+    held = f"""
+#if {P}_ENABLE_PARSER || {P}_ENABLE_ENCODE
+/* 1 when the direction's layout k sends code `code` (its command element holds only some codes: the others travel in
+ * a layout whose element holds them). */
+static int {p}__sends({p}_direction_t dir, uint8_t k, long code)
+{{
+    (void)code;
+{chr(10).join(sends)}
+    return 1;
+}}
+#endif
+"""
+    if not protocol.framing.by_command:
+        return held
     return f"""
 #if {P}_ENABLE_DECODE
 /* Layouts chosen by command (`layout:`): 1 when the direction's layout k sends code `code` (a layout without a
@@ -1098,6 +1113,11 @@ def source(ctx: Ctx) -> str:
     if chosen:
         skip_refusal += (
             "\n        if (k != only) { /* another command's layout (`layout:`) */\n            continue;\n        }"
+        )
+    elif any(layout_codes(protocol, layout) is not None for layout in every_layout(protocol)):
+        skip_refusal += (
+            f"\n        if (!{p}__sends(dir, k, (long)code)) {{ /* a code its command element cannot hold */"
+            "\n            continue;\n        }"
         )
     refused_fn, refused_call = refused_decoder(ctx, refusals)
     xargs = "present, extras, " if opt else ""

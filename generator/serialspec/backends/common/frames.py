@@ -118,17 +118,6 @@ def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, .
     )
 
 
-def refuse_by_command(protocol: Protocol) -> None:
-    """Unsupported for frames read with the request they answer, in targets that take each frame alone (the C
-    decoder, the Wireshark dissector)."""
-    if protocol.framing.by_command:
-        raise Unsupported("layouts chosen by command (`layout:`)")
-    if protocol.framing.from_request:
-        raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
-    if protocol.framing.by_request(Direction.RESPONSE):
-        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
-
-
 def refuse_code_forms(protocol: Protocol) -> None:
     """Unsupported for a layout whose frames carry an expression of the command's code (`code:`) or a headerless
     layout beside headed ones, in a target that does not do them (the C decoder)."""
@@ -136,8 +125,6 @@ def refuse_code_forms(protocol: Protocol) -> None:
     for layout, _ in layouts:
         if any(e.code for e in layout.elements if e.role == "command"):
             raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
-        if not protocol.framing.by_command and layout.has_command and held_codes(protocol, layout) is not None:
-            raise Unsupported(f"a command element that holds only some codes (layout {layout.name})")
     for layout, alternatives in layouts:
         if alternatives > 1 and not layout.header and not protocol.framing.by_command:
             raise Unsupported(f"a layout without a header beside layouts with one (layout {layout.name})")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from serialspec.backends import Emitter
-from serialspec.backends.common.frames import refuse_by_command
 from serialspec.backends.wireshark.dissector import emit_dissector
 from serialspec.backends.wireshark.text import emit_text_dissector
 from serialspec.lang.model import Protocol
@@ -12,7 +11,6 @@ from serialspec.lang.model import Protocol
 def files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:
         return {f"{protocol.name}/{protocol.name}.lua": emit_text_dissector(protocol, protocol.text)}
-    refuse_by_command(protocol)  # a dissector sees each frame alone, as the C decoder does
     return {f"{protocol.name}/{protocol.name}.lua": emit_dissector(protocol)}
 
 

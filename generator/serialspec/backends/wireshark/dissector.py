@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Any, assert_never
 
 from serialspec.backends import Unsupported
-from serialspec.backends.common.frames import runtime_layout
+from serialspec.backends.common.frames import layout_codes, runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang.frozen import frozen
@@ -39,6 +39,8 @@ from serialspec.lang.model import (
     Text,
     content_bounds,
     engineering_unit,
+    replies_by_request,
+    reply_to,
     size_terms,
 )
 from serialspec.runtime.framing import Layout
@@ -149,7 +151,23 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
     # (a layout without a header beside ones with a header is tried last: it takes the frames no header starts)
     ordered = sorted(layouts, key=lambda layout: not layout.header) if len(layouts) > 1 else layouts
     variants = [(layout, variant) for layout in ordered for variant in runtime_layout(layout).variants]
-    result: dict[str, Any] = {"layouts": [_layout(layout, variant) for layout, variant in variants], "codes": codes}
+    result: dict[str, Any] = {"layouts": [], "codes": codes}
+    for layout, variant in variants:
+        item = _layout(layout, variant)
+        item["name"] = layout.name
+        found = layout_codes(protocol, layout) if protocol.framing.by_command else None
+        if found is not None:  # layouts chosen by command: the codes its frames send, as a set
+            item["codes"] = {code: True for code in found}
+        result["layouts"].append(item)
+    if protocol.framing.by_request(direction):
+        # replies that carry no code, read in the layout of the request they answer: each reply by its key (the
+        # request's message names it, `answer`), with its layout
+        result["answers"] = {}
+        for message in protocol.messages():
+            if message.direction == direction and not message.unsolicited:
+                entry = {"message": _message(protocol, message), "layout": protocol.layout(message).name}
+                entry["min"], entry["max"] = entry["message"]["min"], entry["message"]["max"]
+                result["answers"][message.key] = entry
     if protocol.error_reply is not None:
         result["error_flag"] = protocol.error_reply.flag
         result["error_element"] = protocol.error_reply.element
@@ -189,6 +207,8 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
             item["checksum"] = _checksum(element.checksum)
             if runtime.skip:  # the elements it leaves out, as a set: skip[i] is true
                 item["skip"] = {i + 1: True for i in runtime.skip}
+            if element.checksum.from_request:  # the request's elements it takes in first (`from_request`)
+                item["request"] = list(element.checksum.from_request)
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
@@ -257,6 +277,10 @@ def _message(protocol: Protocol, message: Message) -> dict[str, Any]:
         result["refused"] = protocol.error_reply.element
     if message.padded is not None:  # truncate: trailing_zeros
         result["padded"] = message.padded
+    if message.direction == Direction.REQUEST and protocol.framing.by_request(Direction.RESPONSE):
+        reply = reply_to(message, replies_by_request(protocol.messages()))
+        if reply is not None:  # the reply it gets (in `answers`), where replies are read with their request
+            result["answer"] = reply.key
     return result
 
 

@@ -252,3 +252,22 @@ def test_a_spy_log_replays_with_register_names_from_the_request_before(tmp_path:
         assert [(d["direction"], d["command"]) for d in decoded][:2] == [("request", "read"), ("response", "reply")]
         assert decoded[1]["registers"] == {"model_number": 777}
         assert all("registers" not in d for d in decoded[2:] if d["direction"] == "response")
+
+
+def test_a_capture_pairs_each_reply_read_with_its_request(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """RoboClaw: a read's reply carries no code and its CRC covers the request's address and command. `decode
+    --file` gave its bytes as "outside any frame" (the replies' stream never knew the request), then, once it did,
+    stopped on re-encoding the reply without it; each reply is read with the request seen before it."""
+    from serialspec.cli import main as serialspec_main
+
+    capture = tmp_path / "roboclaw.capture"
+    when = "2026-11-22T09:40:01.123456+00:00"
+    lines = [("request", "80 18"), ("response", "00 78"), ("response", "c8 65"), ("request", "81 18")]
+    capture.write_text("".join(f"{when} {d} {data}\n" for d, data in lines), encoding="utf-8")
+    assert serialspec_main(["decode", str(ROOT / "specs" / "roboclaw.yaml"), "--file", str(capture), "--json"]) == 0
+    shown = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(s["direction"], s["command"], s["fields"]) for s in shown] == [
+        ("request", "read_main_battery", {"address": 128}),
+        ("response", "read_main_battery", {"voltage": 120}),
+        ("request", "read_main_battery", {"address": 129}),
+    ]

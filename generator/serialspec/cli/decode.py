@@ -174,6 +174,9 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
     replies = replies_by_request(protocol.messages())
     asked: Message | None = None  # the last request seen
     awaited: str | None = None  # text: the code of a reply of values alone that the last request gets
+    # binary frames read with their request (layouts chosen by command, a reply CRC over request bytes): the reply
+    # class the last request gets, and that request, for the replies' own stream
+    expecting: tuple[type, Message] | None = None
     stream = sys.stdin if args.file == "-" else capture.open_text(args.file)
     with stream:
         try:
@@ -183,6 +186,9 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                 if text and direction == "response" and awaited is not None:
                     frames.expect_text(awaited)  # the reply's own stream reads it as the answer, once
                     awaited = None
+                if direction == "response" and expecting is not None:
+                    frames.expect(*expecting)
+                    expecting = None
                 for seen in frames.feed(chunk.data, number):
                     if seen.message is None:
                         failed += 1
@@ -199,6 +205,9 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                     else:
                         if message.DIRECTION.value == "request":
                             asked = message
+                            reply_spec = reply_to(message_spec(protocol, asked), replies)
+                            if direction == "request" and reply_spec is not None and protocol.framing.requesting:
+                                expecting = (getattr(package, reply_spec.class_name), asked)
                         elif asked is not None and reply_to(message_spec(protocol, asked), replies) is message_spec(
                             protocol, message
                         ):

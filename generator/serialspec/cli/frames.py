@@ -61,6 +61,19 @@ class Frames:
         self._origins: list[tuple[int, object]] = []
         self._run: _Run | None = None
 
+    def _encoded(self, message: Message) -> bytes:
+        """A message's frame again (its bytes in the stream): a reply read with its request, encoded with it (its
+        checksum may take in bytes of the request)."""
+        request = getattr(self._parser, "request", None)
+        return self.package.encode(message) if request is None else self.package.encode(message, request)  # type: ignore[no-any-return]
+
+    def expect(self, cls: type, request: Message) -> None:
+        """The reply class the next frames answer and the request they answer (binary frames read with their
+        request: layouts chosen by command, a reply checksum over request bytes), seen in the other direction's
+        stream."""
+        if self._paired is None:
+            self._parser.expect(cls, request)
+
     def expect_text(self, reply: str) -> None:
         """A text protocol's reply of values alone (`values_only`) with this code answers the request just seen
         in the other direction's stream: the next line is read as it."""
@@ -76,7 +89,7 @@ class Frames:
         if self._paired is not None:
             frames = self._paired.feed(chunk)
         else:
-            frames = [(message, self.package.encode(message)) for message in self._parser.feed(chunk)]
+            frames = [(message, self._encoded(message)) for message in self._parser.feed(chunk)]
         failed = self._parser.errors - errors
         held = self.pending()
         end = len(stream) - len(held)  # the bytes held back are the stream's last

@@ -6,6 +6,7 @@ rebuilt, never used; and an unwritable or forbidden cache folder changes nothing
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -421,3 +422,27 @@ def test_decode_with_units_takes_the_model_from_the_cache(tmp_path: Path) -> Non
     again = _decode_imports(tmp_path, "--units").splitlines()
     assert again[:2] == ["feetech_sms request ping  [ff ff 01 02 01 fb]", "  id                   1"]
     assert "resolve" not in again[-1] and "yaml" not in again[-1] and "'serialspec.lang.model'" in again[-1]
+
+
+def test_decode_by_package_says_what_decode_by_spec_says(capsys: pytest.CaptureFixture[str]) -> None:
+    """`decode PACKAGE` (from the generated package alone) and `decode SPEC` print the same JSON for every example of
+    every shipped binary spec that decodes alone (not a reply read with its request). Found: RoboClaw's read
+    requests, whose layout has no CRC, were `"checksum_ok": true` from the package and null from the spec."""
+    from serialspec.cli import main as serialspec_main
+
+    compared = 0
+    for path in sorted((ROOT / "specs").glob("*.yaml")):
+        protocol = load_protocol(str(path))
+        if protocol.text is not None:
+            continue
+        for example in protocol.examples:
+            if example.request:
+                continue
+            frame = example.frame.hex(" ")
+            shown = []
+            for source in (protocol.name, str(path)):
+                assert serialspec_main(["decode", source, frame, "--direction", example.direction.value, "--json"]) == 0
+                shown.append(json.loads(capsys.readouterr().out))
+            assert shown[0] == shown[1], (path.name, example.name)
+            compared += 1
+    assert compared > 50

@@ -31,9 +31,10 @@ MODELS: dict[int, str] = {
     2825: 'sts3250',
     11272: 'sm8512bl',
 }
-#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
-#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
-#: address, register map in `registers`).
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum
+#: (where layouts are chosen by command: the message classes whose layout carries one), and the messages whose bytes
+#: are a run of registers (class name: bytes field, field holding the first register's address, register map in
+#: `registers`).
 CHECKSUMMED: tuple[str, ...] = ('request', 'response')
 REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {
     'WriteRequest': ('data', 'address', 'CONTROL_TABLE'),

@@ -24,9 +24,10 @@ BAUDRATE = 1000000
 SERIAL = SerialSettings(baudrate=1000000, bytesize=8, parity='none', stopbits=1.0)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('command', 'subcommand', 'servo_id')
-#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
-#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
-#: address, register map in `registers`).
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum
+#: (where layouts are chosen by command: the message classes whose layout carries one), and the messages whose bytes
+#: are a run of registers (class name: bytes field, field holding the first register's address, register map in
+#: `registers`).
 CHECKSUMMED: tuple[str, ...] = ('request', 'response')
 REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {}
 

@@ -25,9 +25,10 @@ BAUDRATE = 19200
 SERIAL = SerialSettings(baudrate=19200, bytesize=7, parity='even', stopbits=1.0)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('unit', 'command')
-#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
-#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
-#: address, register map in `registers`).
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum
+#: (where layouts are chosen by command: the message classes whose layout carries one), and the messages whose bytes
+#: are a run of registers (class name: bytes field, field holding the first register's address, register map in
+#: `registers`).
 CHECKSUMMED: tuple[str, ...] = ('request', 'response')
 REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {}
 

@@ -26,10 +26,11 @@ BAUDRATE = 38400
 SERIAL = SerialSettings(baudrate=38400, bytesize=8, parity='none', stopbits=1.0)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('command',)
-#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum,
-#: and the messages whose bytes are a run of registers (class name: bytes field, field holding the first register's
-#: address, register map in `registers`).
-CHECKSUMMED: tuple[str, ...] = ('request', 'response')
+#: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum
+#: (where layouts are chosen by command: the message classes whose layout carries one), and the messages whose bytes
+#: are a run of registers (class name: bytes field, field holding the first register's address, register map in
+#: `registers`).
+CHECKSUMMED: tuple[str, ...] = ('DriveForwardM1Request', 'DriveBackwardM1Request', 'DriveForwardM2Request', 'DriveBackwardM2Request', 'ReadEncoderM1Response', 'ReadEncoderM2Response', 'ReadSpeedM1Response', 'ReadSpeedM2Response', 'ResetEncodersRequest', 'ReadVersionResponse', 'ReadMainBatteryResponse', 'ReadLogicBatteryResponse', 'SetVelocityPidM1Request', 'SetVelocityPidM2Request', 'DutyM1Request', 'DutyM2Request', 'SpeedM1Request', 'SpeedM2Request', 'DutyAccelM1Request', 'DutyAccelM2Request', 'ReadVelocityPidM1Response', 'ReadVelocityPidM2Response', 'ReadErrorResponse')
 REGISTER_VIEWS: dict[str, tuple[str, str, str]] = {}
 
 __all__ = ["BAUDRATE", "CHECKSUMMED", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "REGISTER_VIEWS", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",

@@ -144,7 +144,8 @@ def describe_alone(package: ModuleType, message: Message, frame: bytes) -> dict[
         maps = submodule(package, "registers")
         if isinstance(start, int) and maps is not None:
             registers = dict(getattr(maps, constant).unpack(start, getattr(message, field)))
-    checksum = message.DIRECTION.value in package.CHECKSUMMED
+    checksummed = package.CHECKSUMMED  # directions, or (layouts chosen by command) message classes
+    checksum = message.DIRECTION.value in checksummed or type(message).__name__ in checksummed
     return result(package.PROTOCOL, message, frame, message.to_fields(), checksum, registers, {})
 
 

@@ -138,7 +138,10 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
 
 
 def checksummed_directions(protocol: Protocol) -> tuple[str, ...]:
-    """The directions whose frames carry a checksum (in any of their layouts)."""
+    """The directions whose frames carry a checksum (in any of their layouts); where layouts are chosen by command,
+    the message classes whose own layout carries one instead (RoboClaw's read requests carry none)."""
+    if protocol.framing.by_command:
+        return tuple(m.class_name for m in protocol.messages() if protocol.layout(m).checksums)
     return tuple(
         d.value for d, layouts in protocol.framing.alternatives.items() if any(layout.checksums for layout in layouts)
     )

@@ -30,6 +30,7 @@ from serialspec.lang.model import (
     reply_to,
     sizes_text,
 )
+from serialspec.lang.model.discriminator import discriminator
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
 
@@ -533,7 +534,7 @@ class Commands(FieldResolver):
                             ("commands", users[1][0].name),
                             f"{shared} are told apart by their content size, which needs a length element",
                         )
-                    else:
+                    elif discriminator([m for _, m in users]) is None:
                         self.check_sizes_differ(what, users)
                     continue
                 if any(c.selector for c, _ in users):

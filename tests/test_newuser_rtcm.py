@@ -291,8 +291,33 @@ def test_an_unknown_message_number_is_one_line(rtcm: ModuleType) -> None:
     with pytest.raises(DecodeError) as refused:
         rtcm.decode(frame, "request")
     assert str(refused.value) == (
-        "request None: unknown message_number 1004 (known: station: 1005, station_height: 1006, descriptor: 1033)"
+        "request without a code: unknown message_number 1004 (known: station: 1005, station_height: 1006, "
+        "descriptor: 1033)"
     )
+
+
+@pytest.mark.parametrize(
+    ("first", "why"),
+    [
+        ("{type: u12, const: 1005}", "both begin with message_number = 1005, which cannot pick one"),
+        (
+            "{type: u12}",
+            "a leading constant picks a message only where every one of them begins with a constant integer field of "
+            "the same width, no two equal",
+        ),
+    ],
+)
+def test_a_message_number_that_cannot_pick_is_one_error(first: str, why: str) -> None:
+    """Where 1033's first field is no constant, or 1005's, the sizes must tell the messages apart and cannot."""
+    text = SPEC.read_text(encoding="utf-8").split("\nexamples:")[0]
+    text = text.replace("message_number: {type: u12, const: 1033, description: DF002.}", f"message_number: {first}")
+    with pytest.raises(SpecErrors) as failure:
+        resolve(load_text(text, "rtcm3.yaml"))
+    assert str(failure.value).splitlines() == [
+        "rtcm3.yaml:68:5: commands.descriptor: 'station' also sends requests without a code, and a content of 19 "
+        "bytes fits both (requests without a code are told apart by their content size: 19 bytes and 9..1284 bytes; "
+        f"{why})"
+    ]
 
 
 text = st.text(st.characters(min_codepoint=32, max_codepoint=126), max_size=40)

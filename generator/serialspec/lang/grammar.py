@@ -405,7 +405,12 @@ _FIELD_LONG: dict[str, Shape] = {
         example=-1000,
     ),
     "range": RANGE,
-    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
+    "const": Int(
+        "The field always has this value (sub-command selectors, fixed addresses). As the first field of messages "
+        "that share a code (or frames without one), it picks the message (RTCM 3's message number: see "
+        "commands.NAME).",
+        example=1,
+    ),
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),

@@ -74,7 +74,7 @@ def size_dispatch(key: str, code: int | None, direction: Direction, messages: li
     found: dict[str, Any] = {
         "name": f"_decode_{direction.value}_{code_name}_by_size",
         "ranges": [(m.min_size, m.max_size, decoder_name(m)) for m in sorted(messages, key=lambda m: m.min_size)],
-        "where": f"{direction.value} {key}",
+        "where": f"{direction.value} {key}" if code is not None else f"{direction.value} without a code",
         "sizes": ", ".join(f"{m.command}: {sizes_text(m)}" for m in messages),
         "lead": None,
     }

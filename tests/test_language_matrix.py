@@ -770,7 +770,17 @@ SHARED_CODE = {
     "poll": {"code": 1, "request": {"fields": {}}},
     "long": {"code": 1, "request": {"fields": {"a": "u8", "b": "u16", "data": {"type": "bytes", "size": "rest"}}}},
 }
-CASES["requests sharing a code, by content size"] = Case({"v": "u16"}, {"w": "u8"}, commands=SHARED_CODE)
+# (and in the usual frame, code 2 shared by requests of one size picked by a leading u8 constant: the case of
+# leading constants below, whole bytes in a coded frame)
+CASES["requests sharing a code, by content size or a leading u8"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    commands={
+        **SHARED_CODE,
+        "get": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 1}, "a": "u16"}}},
+        "put": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 2}, "b": "i16"}}},
+    },
+)
 CASES["requests sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u16"},
@@ -803,14 +813,6 @@ CASES["requests picked by a leading constant bit field, no command element"] = C
                 }
             }
         },
-    },
-)
-CASES["requests sharing a code, picked by a leading u8"] = Case(
-    {"v": "u16"},
-    {"w": "u8"},
-    commands={
-        "poll": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 1}, "a": "u16"}}},
-        "set": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 2}, "b": "i16"}}},
     },
 )
 # The device rules and unsolicited output: the simulator sends `beat` every 5 ms while the client's requests are

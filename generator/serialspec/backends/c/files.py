@@ -34,14 +34,15 @@ from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
     Direction,
+    Discriminator,
     FrameElement,
     FrameLayout,
     Message,
     Protocol,
+    discriminator,
     nul_ended,
     size_terms,
 )
-from serialspec.lang.model.discriminator import Discriminator, discriminator
 from serialspec.transforms.replace import Replace
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)

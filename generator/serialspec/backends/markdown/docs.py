@@ -45,9 +45,9 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    discriminator,
     fixed_size,
 )
-from serialspec.lang.model.discriminator import discriminator
 from serialspec.lang.names import mangled, python_name
 from serialspec.runtime.errors import SerialspecError
 

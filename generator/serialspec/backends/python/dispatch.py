@@ -6,8 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, sizes_text
-from serialspec.lang.model.discriminator import discriminator
+from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, discriminator, sizes_text
 
 
 def message_function(verb: str, message: Message) -> str:

@@ -38,12 +38,12 @@ from serialspec.lang.model import (
     TableValue,
     Text,
     content_bounds,
+    discriminator,
     engineering_unit,
     replies_by_request,
     reply_to,
     size_terms,
 )
-from serialspec.lang.model.discriminator import discriminator
 from serialspec.runtime.framing import Layout
 
 

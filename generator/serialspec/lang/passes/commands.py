@@ -25,12 +25,13 @@ from serialspec.lang.model import (
     Table,
     TableEntry,
     content_bounds,
+    discriminator,
     fixed_size,
+    leading_constant,
     replies_by_request,
     reply_to,
     sizes_text,
 )
-from serialspec.lang.model.discriminator import discriminator, leading_constant
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
 

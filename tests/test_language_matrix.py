@@ -770,12 +770,50 @@ SHARED_CODE = {
     "poll": {"code": 1, "request": {"fields": {}}},
     "long": {"code": 1, "request": {"fields": {"a": "u8", "b": "u16", "data": {"type": "bytes", "size": "rest"}}}},
 }
-CASES["requests sharing a code, by content size"] = Case({"v": "u16"}, {"w": "u8"}, commands=SHARED_CODE)
+# (and in the usual frame, code 2 shared by requests of one size picked by a leading u8 constant: the case of
+# leading constants below, whole bytes in a coded frame)
+CASES["requests sharing a code, by content size or a leading u8"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    commands={
+        **SHARED_CODE,
+        "get": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 1}, "a": "u16"}}},
+        "put": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 2}, "b": "i16"}}},
+    },
+)
 CASES["requests sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u16"},
     CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
     commands=SHARED_CODE,
+)
+# Messages picked by their leading constant (lang/model/discriminator.py), before sizes that overlap: RTCM 3's frame
+# without a command element, each request's content beginning with its 12-bit message number (`descriptor`'s
+# counted string makes 4 bytes or more, probe's 5); and requests that share a code, picked by a leading u8
+_RTCM_CRC = CASES["type: u12, i38 (bit runs), a u24 checksum"].framing["elements"]["checksum"]  # type: ignore[index]
+CASES["requests picked by a leading constant bit field, no command element"] = Case(
+    {"msg": {"type": "u12", "const": 1005}, "station": "u12", "v": "u16"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": "D3"},
+            "length": {"role": "length", "type": "u16", "endian": "big", "range": [0, 1023]},
+            "content": {"role": "content"},
+            "checksum": _RTCM_CRC,
+        }
+    },
+    commands={
+        "descriptor": {
+            "request": {
+                "fields": {
+                    "msg": {"type": "u12", "const": 1033},
+                    "station": "u12",
+                    "n": {"type": "u8", "range": [0, 6]},
+                    "name": {"type": "string", "size": "n"},
+                }
+            }
+        },
+    },
 )
 # The device rules and unsolicited output: the simulator sends `beat` every 5 ms while the client's requests are
 # matched to their replies (client_against_simulator), a derived entry, a lock, a move to an expression.

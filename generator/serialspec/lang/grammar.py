@@ -405,7 +405,12 @@ _FIELD_LONG: dict[str, Shape] = {
         example=-1000,
     ),
     "range": RANGE,
-    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
+    "const": Int(
+        "The field always has this value (sub-command selectors, fixed addresses). As the first field of messages "
+        "that share a code (or frames without one), it picks the message (RTCM 3's message number: see "
+        "commands.NAME).",
+        example=1,
+    ),
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
@@ -639,7 +644,9 @@ COMMAND = Obj(
             "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA; GRBL's `$H`): "
             "letters, digits and `$!?~#%&+-./:;=@^_`, none of the framing's own characters. The requests of several "
             "commands may share a code when no content size fits two of them: each is its own message, "
-            "decoded by its size (u-blox: an empty payload polls, a full one sets).",
+            "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
+            "with a constant field of one width, no two equal: each is picked by that value before its size "
+            "(below, RTCM 3's message number). Frames without a command element share the same way.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -695,6 +702,43 @@ COMMAND = Obj(
         "subcommands": MapOf(SUBCOMMAND, "Sub-commands the selector picks: name -> sub-command."),
     },
     description="A command: its code, and the fields of its request and response.",
+    variants=(
+        (
+            "Messages picked by their leading constant (RTCM 3: frames without a command element, each payload "
+            "beginning with its 12-bit message number)",
+            {
+                "station": {
+                    "request": {
+                        "unsolicited": True,
+                        "fields": {
+                            "message_number": {"type": "u12", "const": 1005},
+                            "station_id": "u12",
+                            "height": "u16",
+                        },
+                    }
+                },
+                "descriptor": {
+                    "request": {
+                        "unsolicited": True,
+                        "fields": {
+                            "message_number": {"type": "u12", "const": 1033},
+                            "station_id": "u12",
+                            "antenna_size": "u8",
+                            "antenna": {"type": "string", "size": "antenna_size"},
+                        },
+                    }
+                },
+            },
+            "Where the requests that share a code (or all those of a frame without a command element) each begin "
+            "with a constant integer field of one width (a bit field, `u12` here, or a whole-byte one), no two "
+            "constants equal, decode, the stream parser, the C decoder and the Wireshark dissector read that many "
+            "leading bits of the content and pick the message whose constant they hold, before its size: a "
+            "`descriptor` of 5 bytes (antenna `A`) is a descriptor, though a `station` is 5 bytes too. A value no "
+            "message has is refused in one line (`unknown message_number 1004`). Where some message has no such "
+            "field, or widths or values clash, the messages are told apart by their content size alone, which no "
+            "two may share. The reference says of each message that it is chosen by its constant.",
+        ),
+    ),
 )
 
 ENUM = Obj(

@@ -34,10 +34,12 @@ from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
     Direction,
+    Discriminator,
     FrameElement,
     FrameLayout,
     Message,
     Protocol,
+    discriminator,
     nul_ended,
     size_terms,
 )
@@ -678,6 +680,21 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     return "\n".join(lines)
 
 
+def leading_dispatch(ctx: Ctx, lead: Discriminator, values: tuple[tuple[str, object], ...]) -> list[str]:
+    """The decode dispatch's lines for requests that share a code, picked by their leading constant (RTCM 3's
+    message number: lang/model/discriminator.py): the content's first bytes read as one integer, shifted and
+    masked, then a switch on it."""
+    P = ctx.P
+    order = list(range(lead.size)) if lead.endian == "big" else list(reversed(range(lead.size)))
+    high = lead.size - 1
+    read = " | ".join(f"((unsigned long long)c[{i}] << {8 * (high - k)}u)" for k, i in enumerate(order))
+    value = f"((({read}) >> {lead.shift}u) & {lead.mask:#x}ULL)"
+    body = [f"            if (n < {lead.size}u) {{ return {P}_E_LENGTH; }}", f"            switch ({value}) {{"]
+    for number, message in lead.values:
+        body.append(f"            case {number}ULL: {dec_call(ctx, message, values)}")
+    return [*body, f"            default: return {P}_E_UNKNOWN;", "            }"]
+
+
 def trailing_probe(ctx: Ctx, direction: Direction, layout: FrameLayout, sizes: list[int], command: int) -> list[str]:
     """The probe's lines for a frame whose command element follows a content of one size per code, with no length
     or trailer to size it (TFmini's configuration frames): the smallest frame size whose code is in the command
@@ -1069,6 +1086,8 @@ def source(ctx: Ctx) -> str:
                         body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
+            elif d == Direction.REQUEST and (lead := discriminator(users)) is not None:
+                body += leading_dispatch(ctx, lead, values)  # requests that share a code: by their leading constant
             elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
                     tests = [f"n >= {u.min_size}u"] if u.min_size else []

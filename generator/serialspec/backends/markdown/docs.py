@@ -45,6 +45,7 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    discriminator,
     fixed_size,
 )
 from serialspec.lang.names import mangled, python_name
@@ -224,19 +225,22 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
 
 
 def shared_request_text(protocol: Protocol, message: Message) -> str:
-    """A request that shares its code with others: told apart by its content size."""
+    """A request that shares its code with others (or, in frames without a command element, the frame with them):
+    picked by its leading constant (lang/model/discriminator.py), else told apart by its content size."""
     if message.direction != Direction.REQUEST or message.subcommand is not None:
         return ""
     code = protocol.command(message.command).code
-    others = [
-        m.command
-        for c in protocol.commands
-        if c.code == code and c.name != message.command and (m := c.request) is not None
-    ]
-    if not isinstance(code, int) or not others:
+    sharing = [m for c in protocol.commands if c.code == code and (m := c.request) is not None and not c.selector]
+    others = [m.command for m in sharing if m.command != message.command]
+    if not others or not (isinstance(code, int) or code is None):
         return ""
     names = ", ".join(f"`{name}`" for name in others)
-    return f"shares code {code:#04x} with {names}, told apart by the content size"
+    shares = f"shares code {code:#04x} with {names}" if code is not None else f"sent without a code as {names} are"
+    lead = discriminator(sharing)
+    if lead is not None:
+        value = next(v for v, m in lead.values if m.key == message.key)
+        return f"{shares}, chosen by its {lead.name} ({value}, the content's first {lead.bits} bits)"
+    return f"{shares}, told apart by the content size"
 
 
 def _value_offset(layout: FrameLayout, element: FrameElement) -> str:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, sizes_text
+from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, discriminator, sizes_text
 
 
 def message_function(verb: str, message: Message) -> str:
@@ -69,12 +69,28 @@ def size_dispatch(key: str, code: int | None, direction: Direction, messages: li
     one), told apart by their content size (the resolver checked that no size fits two): the decoder that picks
     one by the size, for the code's entry in the dispatch table."""
     code_name = "none" if code is None else f"{code:02x}"
-    return {
+    lead = discriminator(messages)
+    found: dict[str, Any] = {
         "name": f"_decode_{direction.value}_{code_name}_by_size",
         "ranges": [(m.min_size, m.max_size, decoder_name(m)) for m in sorted(messages, key=lambda m: m.min_size)],
-        "where": f"{direction.value} {key}",
+        "where": f"{direction.value} {key}" if code is not None else f"{direction.value} without a code",
         "sizes": ", ".join(f"{m.command}: {sizes_text(m)}" for m in messages),
+        "lead": None,
     }
+    if lead is not None:  # picked by their leading constant (lang/model/discriminator.py) rather than by size
+        found["name"] = f"_decode_{direction.value}_{code_name}_by_{lead.name}"
+        found["lead"] = {
+            "size": lead.size,
+            "endian": lead.endian,
+            "shift": lead.shift,
+            "mask": f"{lead.mask:#x}",
+            "field": lead.name,
+            "bits": lead.bits,
+            "table": f"_{direction.name}_{code_name.upper()}_BY_{lead.name.upper()}",
+            "entries": [(value, decoder_name(m)) for value, m in lead.values],
+            "known": ", ".join(f"{m.command}: {value}" for value, m in lead.values),
+        }
+    return found
 
 
 def shared_codes(protocol: Protocol, direction: Direction) -> set[int]:

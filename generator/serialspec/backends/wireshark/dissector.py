@@ -38,6 +38,7 @@ from serialspec.lang.model import (
     TableValue,
     Text,
     content_bounds,
+    discriminator,
     engineering_unit,
     replies_by_request,
     reply_to,
@@ -110,6 +111,7 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
     layouts = protocol.framing.alternatives[direction]
     coded = any(layout.has_command for layout in layouts)  # else every message of this direction is codeless
     codes: dict[int | str, Any] = {}
+    sharing: dict[int | str, list[Message]] = {}  # each key's messages, for a leading constant that picks them
     for command in protocol.commands:
         selector = command.selector
         if selector is not None and direction in selector.offsets:
@@ -134,6 +136,7 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         key = _code(command.wire_code(direction) if coded else None)
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
+        sharing.setdefault(key, []).append(message)
         if key in codes and direction == Direction.REQUEST:  # requests sharing a code: by their content size
             shared = codes[key]
             layouts_by_size = shared.get("by_size") or [shared.pop("message")]
@@ -146,6 +149,19 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
             continue  # replies sharing a code: the one decoded without its request (the default) is shown
         codes[key] = {"message": _message(protocol, message)}
         codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
+    for key, messages in sharing.items():
+        lead = discriminator(messages) if direction == Direction.REQUEST and "by_size" in codes[key] else None
+        if lead is not None:  # picked by their leading constant (lang/model/discriminator.py), before their size
+            if lead.size > 6:
+                raise Unsupported(f"a leading constant of {lead.bits} bits that picks a message (Lua numbers: 48)")
+            codes[key]["lead"] = {
+                "size": lead.size,
+                "big": lead.endian == "big",
+                "divisor": 1 << lead.shift,
+                "modulus": 1 << lead.bits,
+                "field": lead.name,
+                "values": {value: messages.index(m) + 1 for value, m in lead.values},
+            }
     # a layout with optional elements (`present_if`) as the engine's variants: one per choice of them sent or not,
     # told apart by their flag bits like alternative layouts by their constants
     # (a layout without a header beside ones with a header is tried last: it takes the frames no header starts)

@@ -3,7 +3,8 @@
 Everything a backend needs is computed here once: sizes, offsets, the content length bounds a stream parser
 uses to reject stray headers, class names, and which fields are derived (counts, lengths) rather than given.
 Import from `serialspec.lang.model`; the modules are: fields (field kinds and types), sizes, commands (messages and
-how replies pair with requests), framing, examples (and errata), device, text_frames and protocol.
+how replies pair with requests), discriminator (messages picked by a leading constant), framing, examples (and
+errata), device, text_frames and protocol.
 """
 
 from serialspec.lang.model.commands import (
@@ -71,6 +72,15 @@ from serialspec.lang.model.device import (
 )
 from serialspec.lang.model.device import (
     Unsolicited as Unsolicited,
+)
+from serialspec.lang.model.discriminator import (
+    Discriminator as Discriminator,
+)
+from serialspec.lang.model.discriminator import (
+    discriminator as discriminator,
+)
+from serialspec.lang.model.discriminator import (
+    leading_constant as leading_constant,
 )
 from serialspec.lang.model.examples import (
     Erratum as Erratum,

@@ -25,7 +25,9 @@ from serialspec.lang.model import (
     Table,
     TableEntry,
     content_bounds,
+    discriminator,
     fixed_size,
+    leading_constant,
     replies_by_request,
     reply_to,
     sizes_text,
@@ -533,8 +535,8 @@ class Commands(FieldResolver):
                             ("commands", users[1][0].name),
                             f"{shared} are told apart by their content size, which needs a length element",
                         )
-                    else:
-                        self.check_sizes_differ(what, users)
+                    elif discriminator([m for _, m in users]) is None:
+                        self.check_sizes_differ(what, users, code is not None)
                     continue
                 if any(c.selector for c, _ in users):
                     for command, _ in users[1:]:
@@ -552,18 +554,25 @@ class Commands(FieldResolver):
                         "layout a reply is decoded as when its request is unknown)",
                     )
 
-    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]]) -> None:
+    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]], coded: bool) -> None:
         """Requests that share a code are told apart by their content size: no size may fit two of them."""
         for index, (command, message) in enumerate(users):
             for other, earlier in users[:index]:
                 low = max(message.min_size, earlier.min_size)
                 highs = [h for h in (message.max_size, earlier.max_size) if h is not None]
                 if not highs or low <= min(highs):
+                    plural = "" if low == 1 else "s"
+                    used = (
+                        f"{what} in request frames is already used by {other.name!r}"
+                        if coded
+                        else f"{other.name!r} also sends requests without a code"
+                    )
+                    apart = "requests that share a code" if coded else "requests without a code"
                     self.error(
                         ("commands", command.name),
-                        f"{what} in request frames is already used by {other.name!r}, and a content of {low} "
-                        f"byte{'' if low == 1 else 's'} fits both (requests that share a code are told apart by "
-                        f"their content size: {sizes_text(earlier)} and {sizes_text(message)})",
+                        f"{used}, and a content of {low} byte{plural} fits both ({apart} are told apart by their "
+                        f"content size: {sizes_text(earlier)} and {sizes_text(message)}"
+                        f"{clash_text(users, earlier, message)})",
                     )
                     break  # one line a command
 
@@ -736,6 +745,21 @@ class Commands(FieldResolver):
         if position == offset:
             return (*fields, const)
         raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")
+
+
+def clash_text(users: list[tuple[Command, Message]], earlier: Message, message: Message) -> str:
+    """Why a leading constant does not pick between two requests whose sizes overlap (lang/model/discriminator.py):
+    the words to add to the size error, or "" where no message of them begins with one."""
+    firsts = [leading_constant(m) for _, m in users]
+    if all(f is None for f in firsts):
+        return ""
+    one, other = leading_constant(earlier), leading_constant(message)
+    if one is not None and other is not None and one == other:
+        return f"; both begin with {message.fields[0].name} = {one[1]}, which cannot pick one"
+    return (
+        "; a leading constant picks a message only where every one of them begins with a constant integer field of "
+        "the same width, no two equal"
+    )
 
 
 def codeless_replies(commands: list[Command], framing: Framing) -> bool:

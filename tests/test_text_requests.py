@@ -373,6 +373,9 @@ def test_decode_reads_a_reply_of_values_alone_given_its_request(
     assert json.loads(capsys.readouterr().out)["fields"] == {"position": "1.2340", "velocity": "0.5000"}
     assert serialspec_main(["decode", spec, "1.2340 0.5000"]) == 1
     assert capsys.readouterr().err.rstrip().endswith("give the request (--request SENTENCE)")
+    # a request given whose reply is not values alone (`p` gets none): no hint to give the request already given
+    assert serialspec_main(["decode", spec, "1.2340 0.5000", "--request", "p 0 1.0"]) == 1
+    assert capsys.readouterr().err.rstrip().endswith("unknown text code '1.2340' (expected one of f, p)")
 
 
 def test_the_sim_logs_a_request_with_a_decimal(odrive: Any) -> None:

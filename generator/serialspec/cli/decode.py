@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
         reply = None  # with --request: the code of its reply, where that is its values alone
         if args.request:
             asked = package.decode(textframes.frame_of(package.FRAMING, args.request), "request")
-            reply = package.CODEC.reply_code(asked.CODE)
+            reply = package.CODEC.reply_code(asked.CODE) or asked.CODE  # known: no hint to give it
         return textframes.decode(protocol.name, package, sentences, args.json, args.direction, reply)
     from serialspec.cli.views import message_spec
     from serialspec.lang.model import replies_by_request, reply_to

@@ -209,13 +209,14 @@ class TextFraming:
         layouts = {s.layout: None for s in self.sentences if s.layout is not None}
         object.__setattr__(self, "layouts", tuple(layouts))
 
-    def sentence(self, code: str, direction: str | None = None) -> TextSentence:
+    def sentence(self, code: str, direction: str | None = None, asked: bool = False) -> TextSentence:
         """The message a code names, in `direction` where the code names one each way; DecodeError where there is
-        none, or where the code names two and no direction is given."""
+        none, or where the code names two and no direction is given. `asked`: the request before the frame is known
+        (the refusal then does not ask for it)."""
         found = self.by_code.get(code)
         if not found:
             hint = ""
-            if direction != "request" and any(s.bare for s in self.sentences):
+            if direction != "request" and not asked and any(s.bare for s in self.sentences):
                 hint = "; a reply of values alone is read with the request it answers: give the request"
             raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)}){hint}")
         if len(found) == 1:  # the code says the direction (an answer-only code read by a request parser too)
@@ -229,8 +230,8 @@ class TextFraming:
     def decode(self, frame: bytes | str, direction: str | None = None, reply: str | None = None) -> Sentence:
         """One frame (with or without its line ending) -> its sentence; DecodeError says in one line why not.
         `direction` is needed only for a code that names a request and a response. `reply`: the code of the reply
-        awaited (the answer to the request before this frame): where that reply is its values alone (`bare`), a
-        frame that does not start with another message's code is read as it."""
+        awaited (the answer to the request before this frame; given, the request is known): where that reply is its
+        values alone (`bare`), a frame that does not start with another message's code is read as it."""
         text = _ascii(frame)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
@@ -248,7 +249,7 @@ class TextFraming:
             bare = self.by_code.get(reply, {}).get("response")
             if bare is not None and bare.bare and not self._coded(code, direction):
                 return Sentence("", reply, _decode_fields(bare, parts), len(parts), "response")
-        sentence = self.sentence(code, direction)
+        sentence = self.sentence(code, direction, reply is not None)
         values = _decode_fields(sentence, parts[1:])
         return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
 
@@ -898,7 +899,9 @@ class TextCodec:
         """One frame -> its message; DecodeError (ChecksumError) says in one line why not. `direction` ("request"
         or "response") is needed only for a code that names both. A reply of values alone (`values_only`) is read
         as the answer to `request` (a message) or as `expect` (the reply class awaited)."""
-        reply = expect.CODE if expect is not None else self.reply_code(request.CODE) if request is not None else None
+        reply = expect.CODE if expect is not None else None
+        if request is not None:  # the reply of values alone it gets, else its own code: the request is known
+            reply = self.reply_code(request.CODE) or request.CODE
         return self.message(self.framing.decode(frame, direction, reply))
 
     def reply_code(self, code: str) -> str | None:

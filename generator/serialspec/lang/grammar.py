@@ -366,10 +366,22 @@ def bit_fields(description: str) -> MapOf:
                     {
                         "bits": OneOf((Int(), ListOf(Int(), length=2)), where),
                         "enum": Str("Name of an entry in `enums:`."),
+                        "const": Int(
+                            "The bits always hold this value (a sync nibble): decode refuses a value with other bits "
+                            "there (a frame element's: the stream parser sees no frame), encode writes it, and the "
+                            "bits class fills it in.",
+                            example=5,
+                        ),
+                        "default": Int(
+                            "The value the bits class fills in when none is given (reserved bits sent as 0). A frame "
+                            "value element whose every bit field has a `const` or `default` needs no argument.",
+                            example=0,
+                        ),
                         "description": TEXT,
                     },
                     required=("bits",),
-                    description="One sub-field in full: its bit (or bits) and the enum its value belongs to, if any.",
+                    description="One sub-field in full: its bit (or bits), the enum its value belongs to, if any, "
+                    "and a constant or default value.",
                 ),
             ),
             "One sub-field: its bit number or [high, low] bits (short form, `failsafe: 3`, `error: [6, 0]`), or a "

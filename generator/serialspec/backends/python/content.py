@@ -284,10 +284,19 @@ class PackageCode:
             case Scalar() if f.bits and f.bits_class not in self._seen_classes:
                 self._seen_classes.add(f.bits_class)
                 attributes = []
-                for bit in f.bits:
+                # a constant or default bit field is filled in where it and every one after it has one: the class
+                # stays positional
+                preset = len(f.bits)
+                while preset and f.bits[preset - 1].preset is not None:
+                    preset -= 1
+                for index, bit in enumerate(f.bits):
                     kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
                     where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                    attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
+                    if bit.const is not None:
+                        where += f", always {bit.const}"
+                    default = str(bit.preset) if index >= preset else ""
+                    doc = f"{one_line(bit.description or bit.name)} ({where})"
+                    attributes.append(Attribute(bit.name, kind, doc, default))
                 code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
                 code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
                 code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
@@ -632,6 +641,9 @@ class PackageCode:
             for bit in f.bits:
                 used |= bit.mask << bit.low
                 raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
+                if bit.const is not None:
+                    error = f"DecodeError({where} + f': {f.name}.{bit.name} is {{{raw}}}, expected {bit.const}')"
+                    body.append(If(f"{raw} != {bit.const}", (Raise(error),)))
                 if bit.enum:
                     body.append(Code(f"{name}_{bit.name} = {raw}"))
                     parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
@@ -961,8 +973,10 @@ class PackageCode:
             packed = []
             for bit in f.bits:
                 sub = f"{expr}.{bit.name}"
-                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})"
-                body.append(If(f"not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool", (Raise(error),)))
+                low, high = (0, bit.mask) if bit.const is None else (bit.const, bit.const)  # a constant: itself
+                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, {low}, {high})"
+                test = f"not {low} <= {sub} <= {high}" if bit.const is None else f"{sub} != {bit.const}"
+                body.append(If(f"{test} or {sub}.__class__ is bool", (Raise(error),)))
                 packed.append(f"({sub} << {bit.low})" if bit.low else Simple(sub))
             return packed[0] if len(packed) == 1 else " | ".join(packed)
         self.check_scalar(f, expr, body, where)

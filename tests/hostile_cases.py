@@ -468,6 +468,18 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.request.fields.mode.bits.b: overlaps another bit field",
     ),
     (
+        "a constant bit field's value does not fit its bits",
+        "tiny",
+        put("commands/move/request/fields/mode", {"type": "u8", "bits": {"a": {"bits": [3, 0], "const": 16}}}),
+        "commands.move.request.fields.mode.bits.a.const: const 16 does not fit bits 3..0 (0..15)",
+    ),
+    (
+        "a bit field's default does not fit its bits",
+        "tiny",
+        put("commands/move/request/fields/mode", {"type": "u8", "bits": {"a": {"bits": 7, "default": 2}}}),
+        "commands.move.request.fields.mode.bits.a.default: default 2 does not fit bits 7..7 (0..1)",
+    ),
+    (
         "bits of a signed type",
         "tiny",
         put("commands/move/request/fields/mode", {"type": "i8", "bits": {"a": {"bits": 1}}}),

@@ -8,6 +8,7 @@ from typing import Any
 from hypothesis import strategies as st
 from serialspec.lang.model import (
     Array,
+    BitField,
     Bytes,
     Field,
     Group,
@@ -33,9 +34,14 @@ def number(scalar: ScalarType, low: float, high: float) -> st.SearchStrategy[Any
     return st.integers(int(low), int(high))
 
 
+def bit_values(bit: BitField) -> st.SearchStrategy[int]:
+    """A bit field's values: its constant alone where it has one."""
+    return st.just(bit.const) if bit.const is not None else st.integers(0, bit.mask)
+
+
 def scalar_value(f: Scalar) -> st.SearchStrategy[Any]:
     if f.bits:
-        return st.fixed_dictionaries({b.name: st.integers(0, b.mask) for b in f.bits})
+        return st.fixed_dictionaries({b.name: bit_values(b) for b in f.bits})
     return number(f.type, f.minimum, f.maximum)
 
 
@@ -171,7 +177,7 @@ def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[di
     frame = protocol.framing.layouts[message.direction].value_elements
     frame_values = st.fixed_dictionaries(
         {
-            e.name: st.fixed_dictionaries({b.name: st.integers(0, b.mask) for b in e.bits})
+            e.name: st.fixed_dictionaries({b.name: bit_values(b) for b in e.bits})
             if e.bits
             else st.integers(int(e.minimum), int(e.maximum))
             for e in frame

@@ -605,6 +605,25 @@ CASES["frame: plain values, a sequence"] = Case(
         }
     },
 )
+# Constant and default bit fields (`const`, `default`): in a frame value (a sync nibble; no argument needed) and in
+# a content field; decode refuses another constant, encode writes it
+CASES["frame: constant and default bit fields"] = Case(
+    {"word": {"type": "u8", "bits": {"tag": {"bits": [7, 6], "const": 2}, "low": {"bits": [3, 0], "default": 1}}}},
+    {"v": "u8"},
+    {
+        "elements": {
+            "sync": {
+                "role": "value",
+                "type": "u8",
+                "bits": {"nibble": {"bits": [3, 0], "const": 5}, "reserved": {"bits": [7, 4], "default": 0}},
+            },
+            "code": {"role": "command", "type": "u8"},
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["sync", "content"]},
+        }
+    },
+)
 # No command element: one command, its frame a header, a length byte, the content and a sum (generate crashed here)
 CASES["frame: no command element, a length byte"] = Case(
     {"v": "u16", "w": "u8"},

@@ -23,7 +23,7 @@ import pytest
 from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.errors import DecodeError, Timeout
+from serialspec.runtime.errors import DecodeError, EncodeError, Timeout
 from sim_process import serve
 
 if importlib.util.find_spec("Mock") is None:  # before tmc_driver imports it (see the module docstring)
@@ -268,6 +268,7 @@ def test_the_generated_client_against_the_sim(tmc: ModuleType, sim_path: str) ->
     sync = tmc.SyncBits(nibble=5, reserved=0)
     with client_module.Tmc2209Client(sim_path, echo=True) as driver:
         assert driver.read_ioin(sync, 0).version == 0x21
+        assert driver.read_ioin(node=0).version == 0x21  # the datasheet's sync byte, 0x05
         driver.write_tpowerdown(sync, 0, 100)
         assert driver.read_tpowerdown(sync, 0) == 100
         chop = driver.read_chopconf(sync, 0)
@@ -304,11 +305,21 @@ def test_the_sim_keeps_a_register_of_bit_fields_as_one_integer(tmc: ModuleType) 
     assert sim.devices[0].get("gconf") == 0x40
 
 
-@pytest.mark.xfail(strict=True, reason="the language has no constant bit field: the sync nibble is not checked")
 def test_a_frame_whose_sync_nibble_is_not_5_is_refused(tmc: ModuleType) -> None:
+    """A language gap once: `const: 5` on the sync element's `nibble` bit field. decode and the construct struct
+    refuse another nibble, the stream parser sees no frame there, encode refuses one and fills it in if not given."""
     frame = bytes([0x56, 0x00, 0x00])
-    with pytest.raises(DecodeError):
-        tmc.decode(frame + bytes([compute_crc8_atm(list(frame))]), tmc.Direction.REQUEST)
+    frame += bytes([compute_crc8_atm(list(frame))])
+    with pytest.raises(DecodeError, match=r"^sync\.nibble is 6, expected 5$"):
+        tmc.decode(frame, tmc.Direction.REQUEST)
+    structs = importlib.import_module("tmc2209.structs")
+    with pytest.raises(DecodeError, match="sync.nibble is 6"):
+        structs.REQUEST_FRAME.parse(frame)
+    good = bytes.fromhex("55 00 00 cf")
+    assert [m.node for m in tmc.StreamParser(tmc.Direction.REQUEST).feed(frame + good)] == [0]
+    assert tmc.SyncBits(reserved=5) == tmc.SyncBits(nibble=5, reserved=5)
+    with pytest.raises(EncodeError, match="sync.nibble"):
+        tmc.encode(tmc.ReadGconfRequest(sync=tmc.SyncBits(nibble=6, reserved=5), node=0))
 
 
 def test_writing_gstat_clears_the_flags_written_as_1(tmc: ModuleType) -> None:
@@ -455,9 +466,14 @@ commands:
     assert "reply" not in lines[0]
 
 
-@pytest.mark.xfail(strict=True, reason="a frame value element has no default: every request needs the sync byte")
 def test_the_client_sends_the_datasheets_sync_byte_by_itself(tmc: ModuleType) -> None:
+    """A language gap once: `default: 0` on the sync element's `reserved` bits beside the constant nibble; a frame
+    value whose bit fields all have one needs no argument, and the calls that gave it keep working."""
     assert tmc.encode(tmc.ReadGconfRequest(node=0)) == bytes.fromhex("05 00 00 48")
+    sync = tmc.SyncBits(nibble=5, reserved=5)
+    assert tmc.ReadGconfRequest(sync, 0) == tmc.ReadGconfRequest(sync=sync, node=0)
+    with pytest.raises(TypeError, match="missing required argument: 'node'"):
+        tmc.ReadGconfRequest(sync)
 
 
 def test_a_short_frame_is_not_said_to_be_shorter_than_the_smallest_frame(tmc: ModuleType) -> None:

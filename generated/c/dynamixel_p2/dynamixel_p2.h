@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "b90fd12a1237c157dc848880b4df59a27f16ecfcceb54af902e9bf6ce648da6f"
+#define DYNAMIXEL_P2_SPEC_SHA256 "9de1afbbcc454d64d4f8aa374c23dc278e09a39ba65d9a4cf60e41505277ef5f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -1722,6 +1722,16 @@ local function annotate(f, item, value, scope)
   scope[f.name] = value
 end
 
+-- why `value` is refused by a constant bit field of f (`const:`), nil when it holds every one
+local function wrong_constant(f, value)
+  for _, b in ipairs(f.bits or {}) do
+    local got = b.const and band(rshift(value, b.low), width_mask(b.high - b.low + 1))
+    if b.const and got ~= b.const then
+      return string.format("%s.%s is %d, expected %d", f.name, b.name, got, b.const)
+    end
+  end
+end
+
 local function add_scalar(f, tree, range, scope)
   local value = number(range, f.type, f.big)
   local item
@@ -1738,6 +1748,8 @@ local function add_scalar(f, tree, range, scope)
   end
   for _, b in ipairs(f.bits or {}) do add(item, b.pf, range, f.big) end
   for _, flag in ipairs(f.flags or {}) do add(item, flag.pf, range, f.big) end
+  local wrong = wrong_constant(f, value)
+  if wrong then error(wrong, 0) end
   annotate(f, item, value, scope)
 end
 
@@ -2221,6 +2233,11 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
       local item = add(root, element.pf, ranges[index], element.big)
       for _, b in ipairs(element.bits or {}) do add(item, b.pf, ranges[index], element.big) end
       for _, flag in ipairs(element.flags or {}) do add(item, flag.pf, ranges[index], element.big) end
+      local wrong = wrong_constant(element, value)
+      if wrong then
+        item:add_proto_expert_info(e_malformed, wrong)
+        ok = false
+      end
       if role == "length" then
         local counted = #wire_of(layout, plain, stuffed, element.span[1], element.span[2]) + element.adds
         if counted ~= value then

@@ -366,10 +366,26 @@ def bit_fields(description: str) -> MapOf:
                     {
                         "bits": OneOf((Int(), ListOf(Int(), length=2)), where),
                         "enum": Str("Name of an entry in `enums:`."),
+                        "const": Int(
+                            "The bits always hold this value (a sync nibble): decode refuses a value with other bits "
+                            "there (a frame element's: the stream parser sees no frame), the bits class fills it in "
+                            "and encode writes it (refusing another). Bit fields filled in are defaults of the bits "
+                            "class from the last one with none on.",
+                            example=5,
+                        ),
+                        "default": Int(
+                            "The value the bits class fills in when none is given (reserved bits sent as 0). A value "
+                            "whose every bit field has a `const` or `default` (a frame element's: a sync byte) needs "
+                            "no argument: message classes and client methods default it to the bits class's preset "
+                            "(`SYNC_BITS_PRESET`); later parameters without a default stay positional and are "
+                            "refused (TypeError) when left out.",
+                            example=0,
+                        ),
                         "description": TEXT,
                     },
                     required=("bits",),
-                    description="One sub-field in full: its bit (or bits) and the enum its value belongs to, if any.",
+                    description="One sub-field in full: its bit (or bits), the enum its value belongs to, if any, "
+                    "and a constant or default value.",
                 ),
             ),
             "One sub-field: its bit number or [high, low] bits (short form, `failsafe: 3`, `error: [6, 0]`), or a "

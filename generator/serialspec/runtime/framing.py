@@ -65,6 +65,8 @@ class Element:
     # length: the inclusive range its value must lie in (`range:`), None for any value its bytes hold; a candidate
     # whose length is outside it is no frame, and encode refuses a frame that would need one
     limits: tuple[int, int] | None = None
+    # value: its constant bit fields, (name, lowest bit, mask, constant) each; folded into `need` by the generator
+    fixed: tuple[tuple[str, int, int, int], ...] = ()
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -501,6 +503,9 @@ def _fits(layout: Layout, element: Element, value: int) -> None:
 
 
 def _outside(element: Element, value: int) -> str:
+    for name, low, mask, const in element.fixed:
+        if (value >> low) & mask != const:
+            return f"{element.name}.{name} is {(value >> low) & mask}, expected {const}"
     also = f" (or {element.also})" if element.also is not None else ""
     return f"{element.name} = {value} is outside its range {element.minimum}..{element.maximum}{also}"
 

@@ -73,6 +73,22 @@ else:
         return lambda cls: cls  # what typing's does at run time, but for a marker attribute
 
 
+class _Required:
+    """The default of a parameter that has none but follows one that has (a frame value whose bit fields are all
+    constants or defaults, before the fields): the class refuses it, as Python would a missing argument."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED: Any = _Required()
+
+
+def missing(cls: type, name: str) -> TypeError:
+    """The error for a parameter left at REQUIRED."""
+    return TypeError(f"{cls.__name__}() missing required argument: {name!r}")
+
+
 _ALL = slice(None)
 # tuple's own methods, called on records (typed loosely: to a type checker a record is not a tuple)
 _items: Callable[[object, slice], tuple[Any, ...]] = tuple.__getitem__  # type: ignore[assignment]

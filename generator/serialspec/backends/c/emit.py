@@ -42,6 +42,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    fixed_bits,
 )
 from serialspec.transforms.replace import Replace
 
@@ -620,6 +621,9 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     scope.names[f.name] = local
                 else:
                     out.append(f"{pad}{tgt} = {value};")
+                    mask, bits = fixed_bits(f.bits)
+                    if mask:  # constant bit fields, as Python's decode refuses
+                        out.append(f"{pad}if (({tgt} & {mask}u) != {bits}u) {{ return {ctx.P}_E_CONTENT; }}")
                     # (a signed field keeps its sign: an expression of it, `n >> s`, sees the value, not its bits)
                     unsigned = not (f.type.is_float or wide(f.type) or f.type.signed)
                     scope.names[f.name] = f"(uint32_t){tgt}" if unsigned else tgt
@@ -1074,6 +1078,9 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                 test = range_test(f.minimum, f.maximum, value_type(f), tgt)
                 if test:
                     out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                mask, bits = fixed_bits(f.bits)
+                if mask:  # constant bit fields
+                    out.append(f"{pad}if (({tgt} & {mask}u) != {bits}u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
             case Array():
                 test = range_test(f.minimum, f.maximum, f.item, f"{tgt}[i{depth}]")
                 if test:

@@ -40,6 +40,7 @@ from serialspec.lang.model import (
     Message,
     Protocol,
     discriminator,
+    fixed_bits,
     nul_ended,
     size_terms,
 )
@@ -554,8 +555,13 @@ def _prefix(ctx: Ctx, layout: FrameLayout) -> int:
 
 
 def _need(ctx: Ctx, direction: Direction, k: int, e: FrameElement) -> tuple[int, int] | None:
-    """The (mask, bits) a value flag element must have in variant k (optional elements), else None."""
-    return ctx.variants[direction][k].needs.get(e.name) if ctx.variants else None
+    """The (mask, bits) a value element must have: a value flag's in variant k (optional elements), and its
+    constant bit fields; None for any."""
+    variant = ctx.variants[direction][k].needs.get(e.name) if ctx.variants else None
+    mask, bits = fixed_bits(e.bits) if e.role in VALUE_ROLES else (0, 0)
+    if not mask:
+        return variant
+    return (mask, bits) if variant is None else (variant[0] | mask, variant[1] | bits)
 
 
 def _range_test(e: FrameElement, value: str, size: int, need: tuple[int, int] | None = None) -> str | None:
@@ -1167,6 +1173,11 @@ def source(ctx: Ctx) -> str:
                 if e.broadcast is not None:
                     cond = f"({cond}) && m->{ident(name)} != {e.broadcast}u"
                 vchecks.append(f"    if ({cond}) {{ return {P}_E_RANGE; }} /* {name} */")
+            mask, bits = fixed_bits(e.bits)
+            if mask:  # constant bit fields: a value without them is refused, as Python's encode does
+                vchecks.append(
+                    f"    if ((m->{ident(name)} & {mask}u) != {bits}u) {{ return {P}_E_RANGE; }} /* {name} */"
+                )
             vsets.append(f"    values[{i}] = (uint32_t)m->{ident(name)};")
         # replies read with their request: the frame made with the request's bytes (pre) by {p}__encode_<m>, which
         # {p}_encode_reply calls; the public encoder gives none

@@ -7,7 +7,7 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 from __future__ import annotations
 
 from serialspec.backends import Unsupported
-from serialspec.lang.model import Direction, FrameElement, FrameLayout, Message, Protocol
+from serialspec.lang.model import Direction, FrameElement, FrameLayout, Message, Protocol, fixed_bits
 from serialspec.runtime.framing import Element, ElementKind, Layout
 
 KINDS: dict[str, ElementKind] = {
@@ -55,6 +55,8 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         mask=element.present_if[1],
         wire=element.wire,
         limits=length_limits(element) if kind == "length" else None,
+        need=fixed_bits(element.bits) if kind == "value" else (0, 0),
+        fixed=tuple((b.name, b.low, b.mask, b.const) for b in element.bits if b.const is not None and kind == "value"),
     )
 
 

@@ -16,7 +16,7 @@ from serialspec.backends.common import render as common
 from serialspec.backends.common.frames import runtime_layouts
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
-from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
+from serialspec.backends.markdown.kinds import anchor, bit_lines, kind, scalar_range
 from serialspec.collection import without_cycle_collection
 from serialspec.encodings import bit_run
 from serialspec.lang import expression
@@ -492,6 +492,8 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             description = ". ".join(p for p in (sent, e.description) if p)
         else:
             description = e.description
+        if e.bits:
+            description = " ".join(p for p in (description, *bit_lines(e.bits)) if p)
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
         kind = f"{e.size} bytes" if e.role == "optional" else kind
         if e.role == "length" and layout.classic:

@@ -11,7 +11,7 @@ from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.encodings import seven_bit
 from serialspec.lang import expression
-from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
+from serialspec.lang.model import Array, BitField, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
 
 
 def anchor(*parts: str) -> str:
@@ -83,10 +83,7 @@ class ScalarKind(Kind[Scalar]):
     def meaning(self, f: Scalar) -> list[str]:
         parts = []
         if f.bits:
-            for bit in f.bits:
-                where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                enum = f" ({', '.join(f'{v.value}={v.name.lower()}' for v in bit.enum.values)})" if bit.enum else ""
-                parts.append(f"{where}: {bit.name}{enum}.")
+            parts += bit_lines(f.bits)
             parts.append("Other bits must be zero.")
         if f.status_ok is not None:
             parts.append(f"**Status:** {f.status_ok} is success; any other value is a device error (DeviceError).")
@@ -184,3 +181,18 @@ class TableBlockKind(Kind[TableBlock]):
 
 
 kind: Registry[Kind[Any]] = Registry(Kind)
+
+
+def bit_lines(bits: tuple[BitField, ...]) -> list[str]:
+    """A sentence per bit field: its bits, name, enum and constant or default value."""
+    parts = []
+    for bit in bits:
+        where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+        enum = f" ({', '.join(f'{v.value}={v.name.lower()}' for v in bit.enum.values)})" if bit.enum else ""
+        preset = ""
+        if bit.const is not None:
+            preset = f", always {bit.const} (a frame with another value is refused)"
+        elif bit.default is not None:
+            preset = f", default {bit.default}"
+        parts.append(f"{where}: {bit.name}{enum}{preset}.")
+    return parts

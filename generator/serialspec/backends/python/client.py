@@ -23,7 +23,7 @@ from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import asked_commands, request_response_pairs
-from serialspec.backends.python.content import annotation, element_scalar
+from serialspec.backends.python.content import annotation, element_scalar, field_default
 from serialspec.backends.python.kinds import list_item_type
 from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
@@ -389,6 +389,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         for e in protocol.framing.layouts[Direction.REQUEST].value_elements
         if e.sequence
     }
+    required = False  # a parameter's default is REQUIRED (after a value of preset bit fields)
     for request, response in request_response_pairs(protocol):
         command = protocol.command(request.command)
         sub = next((s for s in command.subcommands if s.name == request.subcommand), None)
@@ -400,10 +401,22 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         trailing = True
         defaults: dict[str, str] = {}
         for f in reversed(fields):
-            if trailing and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
-                defaults[f.name] = number(f.default)
+            if trailing and field_default(f):
+                defaults[f.name] = field_default(f)
             else:
                 trailing = False
+        # a value of preset bit fields before fields without a default (a sync byte): its default, theirs REQUIRED
+        # (the message class refuses it), as the message class's parameters
+        after_default = False
+        for f in fields:
+            if f.name in defaults or f.name in sequences:
+                continue
+            if isinstance(f, Scalar) and f.bits and field_default(f):
+                defaults[f.name] = field_default(f)
+                after_default = True
+            elif after_default:
+                defaults[f.name] = "REQUIRED"
+                required = True
         pairs = []
         singles = []
         for f in fields:
@@ -411,6 +424,8 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 continue  # the client fills it in
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
+            if isinstance(f, Scalar) and f.bits and defaults.get(f.name, "REQUIRED") != "REQUIRED":
+                imports.add(defaults[f.name])  # the bits class's preset instance
             pair = pair_group(f)
             single = single_group(f)
             if single is not None:
@@ -697,7 +712,14 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             ],
             key=import_order,
         ),
-        uses_message=any(m["kind"] == "carry" for m in everything) or bool(askers),
+        message_imports=[
+            name
+            for name, used in (
+                ("REQUIRED", required),
+                ("Message", any(m["kind"] == "carry" for m in everything) or bool(askers)),
+            )
+            if used
+        ],
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),

@@ -7,6 +7,7 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 from typing import assert_never
 
@@ -103,6 +104,22 @@ def bound(f: Scalar, value: float) -> str:
     return number(value)
 
 
+def preset_name(bits_class: str) -> str:
+    """The module-level instance of a bits class with every bit field at its constant or default (SyncBits:
+    SYNC_BITS_PRESET), a parameter's default (a call there would be built once anyway, and linters frown on it)."""
+    return re.sub(r"(?<!^)(?=[A-Z])", "_", bits_class).upper() + "_PRESET"
+
+
+def field_default(f: SpecField) -> str:
+    """A field's default as Python source ("" for none): a plain number's `default`, or its bits class built with
+    every bit field's constant or default where each has one."""
+    if not isinstance(f, Scalar):
+        return ""
+    if f.bits:
+        return preset_name(f.bits_class) if all(b.preset is not None for b in f.bits) else ""
+    return number(f.default) if f.default is not None and not f.enum else ""
+
+
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
@@ -156,6 +173,9 @@ class Attribute:
     annotation: str
     doc: str
     default: str = ""
+    # the default shown in the class body too (a trailing run of defaults); False for one only __new__ has: a
+    # frame value made of preset bit fields before fields without a default, and those fields' REQUIRED
+    in_class: bool = True
 
     @property
     def stored(self) -> str:
@@ -180,6 +200,7 @@ class ClassCode:
     from_fields: Lines = field(default_factory=list)
     given_checks: Lines = field(default_factory=list)  # from_fields' checks of the computed values given (`m`)
     helpers: frozenset[str] = frozenset()  # the runtime.fields helpers from_fields calls (as _<name>)
+    default_name: str = ""  # a bits class whose bit fields all have a constant or default: its instance of them
 
     def read_from(self, values: list[Calls]) -> None:
         """from_fields' arguments: each field's value from data, with the helpers they call."""
@@ -259,24 +280,29 @@ class PackageCode:
         return [element_scalar(element) for element in elements]
 
     def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
-        # Defaults only on a trailing run of fields that all have one: classes stay positional.
-        trailing_defaults: set[str] = set()
+        # Defaults only on a trailing run of fields that all have one: classes stay positional. A value made of bit
+        # fields that are all constants or defaults (a sync byte) has its bits class's as a default wherever it is;
+        # the fields after it without one get REQUIRED, which __new__ refuses (positional calls keep working).
+        given = {f.name: field_default(f) for f in fields} if defaults else {}
+        trailing: set[str] = set()
         for f in reversed(fields):
-            if defaults and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
-                trailing_defaults.add(f.name)
-            else:
+            if not given.get(f.name):
                 break
-        return [
-            Attribute(
-                f.name,
-                annotation(f),
-                doc_line(f),
-                number(f.default)
-                if isinstance(f, Scalar) and f.name in trailing_defaults and f.default is not None
-                else "",
-            )
-            for f in fields
-        ]
+            trailing.add(f.name)
+        attributes = []
+        after_default = False
+        for f in fields:
+            default = given.get(f.name, "")
+            if f.name in trailing:
+                attributes.append(Attribute(f.name, annotation(f), doc_line(f), default))
+            elif default and isinstance(f, Scalar) and f.bits:
+                attributes.append(Attribute(f.name, annotation(f), doc_line(f), default, in_class=False))
+                after_default = True
+            else:
+                attributes.append(
+                    Attribute(f.name, annotation(f), doc_line(f), "REQUIRED" if after_default else "", False)
+                )
+        return attributes
 
     def helper(self, f: SpecField) -> None:
         """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
@@ -284,11 +310,22 @@ class PackageCode:
             case Scalar() if f.bits and f.bits_class not in self._seen_classes:
                 self._seen_classes.add(f.bits_class)
                 attributes = []
-                for bit in f.bits:
+                # a constant or default bit field is filled in where it and every one after it has one: the class
+                # stays positional
+                preset = len(f.bits)
+                while preset and f.bits[preset - 1].preset is not None:
+                    preset -= 1
+                for index, bit in enumerate(f.bits):
                     kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
                     where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                    attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
+                    if bit.const is not None:
+                        where += f", always {bit.const}"
+                    default = str(bit.preset) if index >= preset else ""
+                    doc = f"{one_line(bit.description or bit.name)} ({where})"
+                    attributes.append(Attribute(bit.name, kind, doc, default))
                 code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
+                if all(b.preset is not None for b in f.bits):
+                    code.default_name = preset_name(f.bits_class)
                 code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
                 code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
                 self.helper_classes.append(code)
@@ -632,6 +669,9 @@ class PackageCode:
             for bit in f.bits:
                 used |= bit.mask << bit.low
                 raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
+                if bit.const is not None:
+                    error = f"DecodeError({where} + f': {f.name}.{bit.name} is {{{raw}}}, expected {bit.const}')"
+                    body.append(If(f"{raw} != {bit.const}", (Raise(error),)))
                 if bit.enum:
                     body.append(Code(f"{name}_{bit.name} = {raw}"))
                     parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
@@ -961,8 +1001,10 @@ class PackageCode:
             packed = []
             for bit in f.bits:
                 sub = f"{expr}.{bit.name}"
-                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})"
-                body.append(If(f"not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool", (Raise(error),)))
+                low, high = (0, bit.mask) if bit.const is None else (bit.const, bit.const)  # a constant: itself
+                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, {low}, {high})"
+                test = f"not {low} <= {sub} <= {high}" if bit.const is None else f"{sub} != {bit.const}"
+                body.append(If(f"{test} or {sub}.__class__ is bool", (Raise(error),)))
                 packed.append(f"({sub} << {bit.low})" if bit.low else Simple(sub))
             return packed[0] if len(packed) == 1 else " | ".join(packed)
         self.check_scalar(f, expr, body, where)

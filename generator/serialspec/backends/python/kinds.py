@@ -61,8 +61,9 @@ class Kind(Generic[F]):
 
 
 def zero_bits(bits: Sequence[Any]) -> str:
-    """Bit fields (of a field or a frame element) all 0, as JSON: what a device sends when nothing sets them."""
-    return "{" + ", ".join(f"{b.name!r}: 0" for b in bits) + "}"
+    """Bit fields (of a field or a frame element) as JSON, each its constant or default, else 0: what a device
+    sends when nothing sets them."""
+    return "{" + ", ".join(f"{b.name!r}: {b.preset or 0}" for b in bits) + "}"
 
 
 def _numbers_from_json(f: Array | List) -> Calls:
@@ -118,7 +119,8 @@ def bits_expr(f: Scalar) -> str:
     for field in sorted(f.bits, key=lambda b: -b.high):
         if bit > field.high:
             parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit - field.high}))")
-        parts.append(f"{field.name!r} / BitsInteger({field.high - field.low + 1})")
+        bits = f"BitsInteger({field.high - field.low + 1})"
+        parts.append(f"{field.name!r} / " + (bits if field.const is None else f"Const({field.const}, {bits})"))
         bit = field.low - 1
     if bit >= 0:
         parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")

@@ -42,6 +42,7 @@ def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[st
         "to_fields": cls.to_fields,
         "from_fields": cls.from_fields,
         "given_checks": cls.given_checks,
+        "default_name": cls.default_name,
         "where": where,
         "keys": repr(tuple(keys)),
         "json_keys": repr(tuple(spec_name(key) for key in keys)),  # a keyword's field: its spec name in JSON
@@ -91,6 +92,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             *(e["class_name"] for e in enums),
             *(f["class_name"] for f in flag_sets),
             *(c["name"] for c in classes),
+            *(c["default_name"] for c in classes if c["default_name"]),
             "MESSAGE_TYPES",
             "Direction",
             "Message",
@@ -105,6 +107,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             flag_sets=flag_sets,
             enum_imports=[name for name, used in (("IntEnum", enums), ("IntFlag", flag_sets)) if used],
             classes=classes,
+            required=any(a.default == "REQUIRED" for c in classes for a in c["attributes"]),
             message_classes=[c for c in classes if c["name"] in messages],
             exports=exports,
         ),

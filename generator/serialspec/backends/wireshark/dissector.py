@@ -352,7 +352,14 @@ def _scalar_extras(flags: FlagsDef | None, bits: tuple[BitField, ...], enum: Enu
         extras["flags"] = [{"name": b.name.lower(), "bit": b.bit, "description": b.text} for b in flags.bits]
     if bits:
         extras["bits"] = [
-            {"name": b.name, "high": b.high, "low": b.low, "enum": _enum(b.enum), "description": b.description}
+            {
+                "name": b.name,
+                "high": b.high,
+                "low": b.low,
+                "enum": _enum(b.enum),
+                "description": b.description,
+                "const": b.const,
+            }
             for b in bits
         ]
     return extras

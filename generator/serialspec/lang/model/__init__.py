@@ -157,6 +157,9 @@ from serialspec.lang.model.fields import (
 from serialspec.lang.model.fields import (
     engineering_unit as engineering_unit,
 )
+from serialspec.lang.model.fields import (
+    fixed_bits as fixed_bits,
+)
 from serialspec.lang.model.framing import (
     VALUE_ROLES as VALUE_ROLES,
 )

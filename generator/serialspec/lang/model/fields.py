@@ -85,10 +85,27 @@ class BitField:
     low: int
     enum: EnumDef | None
     description: str
+    const: int | None = None  # the bits always hold this value: decode refuses another, encode writes it
+    default: int | None = None  # the value a bits class is built with when none is given
 
     @property
     def mask(self) -> int:
         return (1 << (self.high - self.low + 1)) - 1
+
+    @property
+    def preset(self) -> int | None:
+        """The value the bits class fills in when none is given: the constant, else the default."""
+        return self.const if self.const is not None else self.default
+
+
+def fixed_bits(bits: tuple[BitField, ...]) -> tuple[int, int]:
+    """(mask, value) of the constant bit fields of an integer: a value must hold `value` under `mask`."""
+    mask = value = 0
+    for bit in bits:
+        if bit.const is not None:
+            mask |= bit.mask << bit.low
+            value |= bit.const << bit.low
+    return mask, value
 
 
 @frozen

@@ -466,7 +466,20 @@ class FieldResolver(Pass):
                 self.error(bit_path, "overlaps another bit field")
             used |= mask
             enum = self.reference("enum", self.enums, bit_spec.get("enum"), (*bit_path, "enum"))
-            bits.append(BitField(bit_name, high_bit, low_bit, enum, str(bit_spec.get("description", ""))))
+            preset: dict[str, int | None] = {}
+            for key in ("const", "default"):
+                value = bit_spec.get(key)
+                if value is not None and not 0 <= value <= mask >> low_bit:
+                    self.error(
+                        (*bit_path, key),
+                        f"{key} {value} does not fit bits {high_bit}..{low_bit} (0..{mask >> low_bit})",
+                    )
+                    value = None
+                preset[key] = value
+            if preset["const"] is not None and preset["default"] is not None:
+                self.error((*bit_path, "default"), "a constant bit field has no default: it is always its `const`")
+            description = str(bit_spec.get("description", ""))
+            bits.append(BitField(bit_name, high_bit, low_bit, enum, description, preset["const"], preset["default"]))
         if bits and (scalar.is_float or scalar.signed):
             self.error((*path, "bits"), "bit fields need an unsigned integer type")
         return Scalar(

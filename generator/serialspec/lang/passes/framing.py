@@ -25,6 +25,7 @@ from serialspec.lang.model import (
     Framing,
     ScalarType,
     Transparency,
+    fixed_bits,
 )
 from serialspec.lang.passes.fields import FieldResolver
 from serialspec.runtime.hexbytes import parse_hex
@@ -552,6 +553,8 @@ class FramingPass(FieldResolver):
             and (final.size == 1 or final.endian == "<")
             and names.index(checksums[0].first) <= content_index <= names.index(checksums[0].last)
             and all((e.size or 0) <= 1 or e.endian == "<" for e in elements)
+            # constant bit fields in a value (a sync nibble): the general engine checks them (Element.need)
+            and not any(fixed_bits(e.bits)[0] for e in elements)
         )
         offsets: dict[str, int] = {}
         position = 0

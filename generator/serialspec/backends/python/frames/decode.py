@@ -89,6 +89,12 @@ def decode_lines(
         value = f"v_{element.name}"
         values.append(value)
         body.append(f"{value} = {positions.read(index)}")
+        for name, low, mask, const in element.fixed:  # as the engine words it (framing._outside)
+            got = f"({value} >> {low}) & {mask:#x}" if low else f"{value} & {mask:#x}"
+            body += [
+                f"if {got} != {const}:",
+                f'    raise DecodeError(f"{element.name}.{name} is {{{got}}}, expected {const}")',
+            ]
         full = element.minimum <= 0 and element.maximum >= (1 << (8 * element.size)) - 1
         if full:
             continue

@@ -80,6 +80,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
         args += [f"minimum={e.minimum}", f"maximum={e.maximum}"]
         if e.also is not None:
             args.append(f"also={e.also}")
+    if e.fixed:
+        args += [f"need=({e.need[0]:#x}, {e.need[1]:#x})", f"fixed={e.fixed!r}"]
     if e.limits is not None:
         args.append(f"limits={e.limits}")
     if e.wire:

@@ -914,6 +914,40 @@ CASES[BY_COMMAND] = Case(
         },
     },
 )
+# Layouts chosen by command whose replies carry no code (Bosch BNO055: AA op register length data; a read answered
+# by BB length data, a write by EE status), a read refused by a write's status reply in that reply's own layout
+CASES["frame: layouts chosen by command, a refusal in another layout (refused_by)"] = Case(
+    {"n": {"type": "u8", "range": [1, 9]}},
+    {"data": {"type": "bytes", "size": "rest"}},
+    {
+        "layouts": {
+            "data": {
+                "elements": {
+                    "start": {"role": "header", "value": {"request": "AA", "response": "BB"}},
+                    "op": {"role": "command", "type": "u8", "directions": ["request"]},
+                    "register": {"role": "address", "type": "u8", "directions": ["request"]},
+                    "length": {"role": "length", "type": "u8", "directions": ["response"]},
+                    "content": {"role": "content"},
+                }
+            },
+            "status": {
+                "elements": {
+                    "start": {"role": "header", "value": "EE", "directions": ["response"]},
+                    "content": {"role": "content"},
+                }
+            },
+        }
+    },
+    commands={
+        "write": {
+            "code": 0,
+            "layout": {"request": "data", "response": "status"},
+            "request": {"fields": {"count": "u8", "data": {"type": "bytes", "size": "count"}}},
+            "response": {"fields": {"status": {"type": "u8", "range": [1, 10]}}},
+        },
+    },
+    request_keys={"answered_by": {"command": "probe", "refused_by": ["write"]}},
+)
 # Layouts chosen by command, one with a command element and one without (TFmini: configuration frames 42 57 02 00,
 # parameters, the command byte last; data frames 59 59 with no command): a codeless command travels in its own layout
 MIXED = "frame: layouts chosen by command, one without a command element, the command byte after the content"

@@ -616,7 +616,11 @@ MESSAGE = Obj(
                 "refused_by": ListOf(
                     Str(),
                     "Commands whose responses refuse this request instead (u-blox ACK-NAK): the client waits for "
-                    "the `command`'s reply or one of these, and raises DeviceError naming the refusal.",
+                    "the `command`'s reply or one of these, and raises DeviceError naming the refusal. Where "
+                    "layouts are chosen by command and replies carry no code, a refusal may travel in a layout of its "
+                    "own that starts with another header: decode (given the request), the stream parser and the C "
+                    "read a frame starting with it as the refusal (Bosch BNO055: a read answered by `BB length "
+                    "data`, `refused_by: [write]`, whose reply is `EE status`).",
                     example=["nak"],
                 ),
                 "optional_when": OPTIONAL_WHEN,

@@ -601,6 +601,7 @@ class Unwrapped:
     content: bytes
     parts: tuple[bytes, ...] = ()  # every element's bytes, unstuffed
     extras: Mapping[str, bytes] = field(default_factory=dict)  # the optional elements sent, by name
+    reply: str = ""  # replies read in the layout of their request: the class of a refusal read in its own layout
 
     def named(self) -> dict[str, bytes]:
         """Every element's bytes by its name (what a reply checksum over the request takes in)."""
@@ -666,10 +667,14 @@ class FrameCodec:
         size_rules: dict[Any, SizeRule] | None = None,
         error_flag: int = 0,
         replies: dict[Any, int] | None = None,
+        refusals: dict[str, tuple[str, ...]] | None = None,
     ) -> None:
         """`replies`: frames that carry no code, in layouts chosen by command: each reply class's layout (by index),
         read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
-        three keyed by the class's name, so the construct structs hold them without the message classes)."""
+        three keyed by the class's name, so the construct structs hold them without the message classes).
+        `refusals`: with `replies`, reply class -> the classes of the replies that may refuse its request instead
+        (`refused_by`), each read in its own layout when the frame is not the reply awaited (BNO055: `EE status`
+        for a read answered by `BB length data`)."""
         self.layouts = tuple(layouts)
         self.by_header = tuple(sorted(self.layouts, key=lambda each: not each.header))  # the headerless one last
         # the plain layouts the stream parser sizes frames in (a layout with optional elements: its variants), and
@@ -677,6 +682,7 @@ class FrameCodec:
         self.variants = tuple(variant for layout in self.layouts for variant in layout.variants)
         self._origin = {id(v): i for i, layout in enumerate(self.layouts) for v in layout.variants}
         self.replies = replies or {}
+        self.refusals = refusals or {}
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
@@ -732,11 +738,16 @@ class FrameCodec:
                 raise DecodeError(
                     "a reply without a command code is read in the layout of the request it answers: give the request"
                 )
-            index = self.replies.get(_class_name(expect))
+            name = _class_name(expect)
+            index = self.replies.get(name)
             if index is None and expect is None and len(self.layouts) == 1:
                 return self.layouts[0].unwrap(frame, request)  # one layout: the frame alone, its default reply
             if index is None:
                 raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
+            for refusal in self.refusals.get(name, ()):  # a reply refusing the request, in a layout of its own
+                layout = self.layouts[self.replies[refusal]]
+                if frame.startswith(layout.header) and not frame.startswith(self.layouts[index].header):
+                    return replace(layout.unwrap(frame, request), reply=refusal)
             return self.layouts[index].unwrap(frame, request)
         if any(layout.codes is not None for layout in self.layouts):
             # the refusal of the layout that sends the frame's code first, then any layout's, then a code sent in
@@ -769,7 +780,8 @@ class FrameCodec:
     def probe(self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None) -> int | None:
         """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none.
         `expect`: the reply class awaited, for replies read in the layout of their request (`replies`)."""
-        if self.replies and self.replies.get(_class_name(expect)) != self._origin[id(layout)]:
+        reading = self._reading(layout, expect) if self.replies else None
+        if self.replies and reading is None:
             return -1  # no reply awaited, or one of another layout
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
@@ -795,7 +807,7 @@ class FrameCodec:
             elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
                 return -1
         if layout.command is None:
-            code = _class_name(expect) if self.replies else None
+            code = reading  # type: ignore[assignment]  # (replies' content sizes are by class name)
             if code not in self.content_sizes:
                 return -1
         if layout.content < 0 and layout.transparency is None:
@@ -829,6 +841,15 @@ class FrameCodec:
         if content_size < low or (high is not None and content_size > high):
             return -1
         return layout.overhead + content_size
+
+    def _reading(self, layout: Layout, expect: Any) -> str | None:
+        """The reply class a frame of `layout` is read as: the one awaited if this is its layout, else a refusal of
+        its request whose layout this is (None: neither)."""
+        name = _class_name(expect)
+        index = self._origin[id(layout)]
+        if self.replies.get(name) == index:
+            return str(name)
+        return next((r for r in self.refusals.get(name, ()) if self.replies[r] == index), None)
 
     def _trailing(self, layout: Layout) -> tuple[int, int] | None:
         """Where a command element after the content sits, counted from the frame's end (start, stop), for a

@@ -644,10 +644,20 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             for m in messages(ctx.protocol)
             if m.direction == direction and ctx.protocol.layout(m).name == layout.name
         ]
+        refusing = [  # a reply refusing the request awaited, in this layout of its own (FrameCodec's refusals)
+            (awaited, kind)
+            for awaited, others in asking.refusal_kinds(ctx).items()
+            for kind, index in others
+            if index == k and awaited not in kinds
+        ]
         lines += [
             "    switch (want) {",
             *(f"    case {kind}:" for kind in kinds),
             "        break;",
+            *(
+                f"    case {awaited}:\n        want = {kind}; /* its refusal */\n        break;"
+                for awaited, kind in refusing
+            ),
             "    default:",
             f"        return {P}__NONE; /* no reply awaited, or one of another layout */",
             "    }",
@@ -1330,9 +1340,7 @@ static size_t {p}__least({p}_direction_t dir)
         }}
         k = at < 0 ? 0u : (uint8_t)at;
         r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
-        if (r != {P}_OK) {{
-            return r;
-        }}
+{asking.refusal(ctx, f"{p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg})")}
     }} else {taking.lstrip()}"""
     admits_fn = optional.admits(ctx) if opt else ""
     unwrap_tail = "const uint8_t **content, size_t *clen"

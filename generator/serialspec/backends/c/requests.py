@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from serialspec.backends import Unsupported
 from serialspec.backends.c.emit import Ctx, ident, messages, msg_id
+from serialspec.backends.common.frames import layout_index
+from serialspec.backends.common.pairing import layout_refusals
 from serialspec.lang.model import VALUE_ROLES, Direction, Message, Protocol
 
 
@@ -123,6 +125,55 @@ static int {p}__reply_layout({p}_kind_t kind)
     }}
 }}
 """
+
+
+def refusal_kinds(ctx: Ctx) -> dict[str, list[tuple[str, int]]]:
+    """Reply kind awaited -> (kind, layout index) of each reply refusing its request in a layout of its own."""
+    return {
+        kind_name(ctx, reply): [(kind_name(ctx, m), layout_index(ctx.protocol, m)) for m in others]
+        for reply, others in layout_refusals(ctx.protocol)
+    }
+
+
+def refusal(ctx: Ctx, unwrap: str) -> str:
+    """Lines of {p}__decode_with after the reply awaited failed to unwrap in its layout (`r`, layout `k`): a frame
+    that starts with the header of a reply refusing the request, in a layout of its own, is that reply
+    (FrameCodec.unwrap's `refusals`); `unwrap` is the call that unwraps in layout k."""
+    P, p = ctx.P, ctx.p
+    found = refusal_kinds(ctx)
+    if not found:
+        return f"""        if (r != {P}_OK) {{
+            return r;
+        }}"""
+    cases = []
+    for awaited, others in found.items():
+        tests = "\n".join(
+            f"""                h = {p}__header(dir, {index}u, &hl);
+                if (refused == {P}_KIND_NONE && hl <= len && {p}__same(frame, h, hl)) {{
+                    refused = {kind};
+                    k = {index}u;
+                }}"""
+            for kind, index in others
+        )
+        cases.append(f"            case {awaited}:\n{tests}\n                break;")
+    return f"""        if (r != {P}_OK) {{ /* a reply that refuses the request in a layout of its own (`refused_by`)? */
+            {p}_kind_t refused = {P}_KIND_NONE;
+            size_t hl;
+            const uint8_t *h;
+            switch (expect) {{
+{chr(10).join(cases)}
+            default:
+                break;
+            }}
+            if (refused == {P}_KIND_NONE) {{
+                return r;
+            }}
+            expect = refused;
+            r = {unwrap};
+            if (r != {P}_OK) {{
+                return r;
+            }}
+        }}"""
 
 
 def prototypes(ctx: Ctx) -> str:

@@ -58,6 +58,7 @@ class Commands(FieldResolver):
             self.check_layouts(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
             self.check_seeds(self.ctx.framing)
+            self.ctx.framing = used_layouts(self.ctx.commands, self.ctx.framing)
             self.ctx.framing = replace(
                 self.ctx.framing, codeless_replies=codeless_replies(self.ctx.commands, self.ctx.framing)
             )
@@ -776,6 +777,22 @@ def codeless_replies(commands: list[Command], framing: Framing) -> bool:
     if len(replies) < 2 or any(m.unsolicited for m in replies):
         return False
     return len({(m.min_size, m.max_size) for m in replies}) > 1 or replies[0].min_size != replies[0].max_size
+
+
+def used_layouts(commands: list[Command], framing: Framing) -> Framing:
+    """Where commands name their layouts, each direction's layouts that some message of it travels in (and the
+    error replies'): a layout no request uses is no request layout (BNO055: `EE status` frames are replies only),
+    so no frame is read in it as a request."""
+    if not framing.by_command:
+        return framing
+    alternatives = dict(framing.alternatives)
+    for direction, layouts in framing.alternatives.items():
+        used = {m.layout or layouts[0].name for c in commands for m in c.messages() if m.direction == direction}
+        kept = tuple(layout for layout in layouts if layout.name in used or layout.error)
+        if kept and len(kept) < len(layouts):
+            alternatives[direction] = kept
+    first = {d: alternatives[d][0] if alternatives.get(d) else framing.layouts[d] for d in framing.layouts}
+    return replace(framing, alternatives=alternatives, layouts=first)
 
 
 def message_path(message: Message) -> Path:

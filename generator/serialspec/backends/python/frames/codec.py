@@ -13,7 +13,7 @@ from serialspec.backends.python.dispatch import (
     decoder_name,
     direction_dispatch,
 )
-from serialspec.backends.python.frames.engine import checksum_definitions, codec_lines
+from serialspec.backends.python.frames.engine import checksum_definitions, codec_lines, reply_refusals
 from serialspec.backends.python.ir import (
     ContentSize,
 )
@@ -132,8 +132,17 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         values = tuple(e.name for e in layout.value_elements)
         requesting = protocol.framing.requesting
         optional = tuple(e.name for e in optional_elements(protocol, direction))
+        refusals = (
+            sorted({r for rs in reply_refusals(protocol).values() for r in rs}) if direction.name == "RESPONSE" else []
+        )
         frames = Target(
-            direction.name, values, expected=bool(expected), only=only, requesting=requesting, optional=optional
+            direction.name,
+            values,
+            expected=bool(expected),
+            only=only,
+            requesting=requesting,
+            optional=optional,
+            refusals=tuple(refusals),
         )
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
@@ -149,6 +158,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
             sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]
             single = {repr(m.class_name): m for m in answering}
         frame_codec, used = codec_lines(protocol, direction, sizes, single)
+        if refusals:  # the classes the frame engine names (Unwrapped.reply)
+            shown = ", ".join(f"{name!r}: {name}" for name in refusals)
+            frame_codec = [f"_{direction.name}_REFUSALS: dict[str, type[Message]] = {{{shown}}}", *frame_codec]
         names |= used
         directions.append(
             {

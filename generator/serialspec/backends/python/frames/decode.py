@@ -330,6 +330,11 @@ def _engine_decode(decode: Lines, target: Target) -> Lines:
         if target.refusing
         else []
     )
+    if target.refusals:  # the frame engine read a reply refusing the request in that reply's own layout
+        refusing += [
+            "    if unwrapped.reply:  # a reply that refuses the request (`refused_by`), in its own layout",
+            f"        expect = _{target.upper}_REFUSALS[unwrapped.reply]",
+        ]
     return [*decode, *refusing, *(f"    {line}" for line in dispatch_lines(target, "code", arguments, nullable=True))]
 
 

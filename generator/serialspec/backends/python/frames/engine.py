@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from serialspec.backends.common.frames import layout_codes, layout_index, runtime_element
+from serialspec.backends.common.pairing import layout_refusals
 from serialspec.backends.python.checksum_code import checksum_name
 from serialspec.backends.python.dispatch import ERROR_REPLY
 from serialspec.checksums.base import Import
@@ -174,7 +175,18 @@ def codec_lines(
             if m.direction == direction
         ]
         lines.append("    },")
+        refusing = reply_refusals(protocol)
+        if refusing:
+            lines.append("    refusals={")
+            lines += [f"        {name!r}: {tuple(others)!r}," for name, others in refusing.items()]
+            lines.append("    },")
     return [*lines, ")"], names
+
+
+def reply_refusals(protocol: Protocol) -> dict[str, tuple[str, ...]]:
+    """The FrameCodec's `refusals`: reply class name -> the class names of the replies refusing its request in a
+    layout of their own (see layout_refusals)."""
+    return {reply.class_name: tuple(m.class_name for m in others) for reply, others in layout_refusals(protocol)}
 
 
 def framing_imports(names: Iterable[str]) -> list[str]:

@@ -53,6 +53,8 @@ class Target:
     requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
     optional: tuple[str, ...] = ()  # the optional elements (`present_if`) the messages carry: the engine's
     refusing: bool = False  # some layout's frames are error replies (an error header): the engine's code asks
+    # replies read in the layout of their request, refused in another: class name -> class (`_RESPONSE_REFUSALS`)
+    refusals: tuple[str, ...] = ()
 
 
 def straight(layout: Layout) -> bool:

@@ -275,6 +275,16 @@ def test_sim_banner_says_what_is_served_in_words() -> None:
     assert banner("hiwonder_rrc", [1]) == "servo_id 1; pwm_servo servo_id 1, 2, 3, 4; motor motor_id 0, 1, 2, 3"
 
 
+def test_field_values_beside_fields_are_named(capsys: pytest.CaptureFixture[str]) -> None:
+    """`encode --json '{"command": "rotate", "servo_id": 1, ...}'` said "missing field 'servo_id'" of a field the
+    user gave, one level too high (found writing iRobot's Open Interface as a new user)."""
+    given = '{"command": "rotate", "servo_id": 1, "angle": 0, "interval": 0, "fields": {}}'
+    assert main(["encode", "fashionstar_uart", "--json", given]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec encode: --json: unknown keys angle, interval, servo_id (field values go in `fields`)"
+    )
+
+
 def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pytest.CaptureFixture[str]) -> None:
     """`encode --json '{"command": "rotat"}'` said only "has no request 'rotat'", and a shared-header frame "give the
     direction" without naming the option (found following the README from the wheel)."""

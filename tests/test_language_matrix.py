@@ -800,6 +800,23 @@ CASES["requests sharing a code, by content size or a leading u8"] = Case(
         "put": {"code": 2, "request": {"fields": {"kind": {"type": "u8", "const": 2}, "b": "i16"}}},
     },
 )
+# Requests that share a code and one fixed size, picked by a leading u8, in a frame with no length (iRobot's Open
+# Interface: the opcode alone, 8E 16 asks for the voltage, 8E 17 the current): the size of the one size
+CASES["requests sharing a code and one size, picked by a leading u8, no length element"] = Case(
+    {"v": "u16"},
+    {"w": "u16"},
+    {
+        "elements": {
+            "start": {"role": "header", "value": "A5", "directions": ["response"]},  # (replies of their own)
+            "opcode": {"role": "command", "type": "u8", "directions": ["request"]},
+            "content": {"role": "content"},
+        }
+    },
+    commands={
+        "voltage": {"code": 0x8E, "request": {"fields": {"packet": {"type": "u8", "const": 22}}}},
+        "current": {"code": 0x8E, "request": {"fields": {"packet": {"type": "u8", "const": 23}}}},
+    },
+)
 CASES["requests sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u16"},

@@ -48,6 +48,11 @@ def run(args: argparse.Namespace) -> int:
     fields = data.get("fields", {})
     if not isinstance(fields, dict):
         raise EncodeError("`fields` must be an object")
+    printed = {"protocol", "direction", "command", "subcommand", "fields", "checksum_ok", "hex", "units", "registers"}
+    astray = sorted(set(data) - printed - {"time"})  # what decode --json (and a capture's lines) print
+    if astray:  # {"command": "drive", "velocity": -200}: the field values belong in `fields`
+        keys = ", ".join(astray)
+        raise EncodeError(f"--json: unknown key{'s' if len(astray) > 1 else ''} {keys} (field values go in `fields`)")
     message = cls.from_fields(fields)  # type: ignore[attr-defined]
     if args.request and takes_request(package.encode):  # a reply made with its request (a checksum over its bytes)
         try:

@@ -756,7 +756,10 @@ COMMAND = Obj(
             "`descriptor` of 5 bytes (antenna `A`) is a descriptor, though a `station` is 5 bytes too. A value no "
             "message has is refused in one line (`unknown message_number 1004`). Where some message has no such "
             "field, or widths or values clash, the messages are told apart by their content size alone, which no "
-            "two may share. The reference says of each message that it is chosen by its constant.",
+            "two may share. The reference says of each message that it is chosen by its constant. In a frame "
+            "without a length element, the requests that share a code need one fixed content size, which sizes "
+            "their frames (iRobot's Open Interface: `8E 16` asks for the voltage, `8E 17` the current, both "
+            "`code: 0x8E` with `packet_id: {type: u8, const: 22}` or `23`).",
         ),
     ),
 )

@@ -29,7 +29,7 @@ from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, wi
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
-from serialspec.backends.common.frames import layout_codes, layout_index, length_limits
+from serialspec.backends.common.frames import layout_codes, layout_index, length_limits, sizing_message
 from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -2129,8 +2129,9 @@ def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
     """The content size of each code whose one message is sized by its own leading fields (model.size_terms)."""
     rows = []
     for key, users in probe_keys(ctx, direction):
-        found = size_terms(users[0].fields) if len(users) == 1 else None
-        text = nul_ended(users[0].fields) if len(users) == 1 and found is None else None
+        sizing = sizing_message(users)
+        found = size_terms(sizing.fields) if sizing is not None else None
+        text = nul_ended(sizing.fields) if sizing is not None and found is None else None
         if text is not None:  # a NUL-terminated text ends the content: sized by its NUL (runtime SizeRule.nul)
             rows.append(
                 f"        case {key}: {{\n            size_t i;\n"

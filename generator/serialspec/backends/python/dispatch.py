@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from serialspec.backends.common.frames import sizing_message
 from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, discriminator, sizes_text
 
 
@@ -123,6 +124,9 @@ class DirectionDispatch:
     dispatch: list[tuple[str, str]] = field(default_factory=list)
     sizes: list[tuple[str, int, int | None]] = field(default_factory=list)
     single: dict[str, Message] = field(default_factory=dict)
+    # each code's content size rule's message: its one message, or one of the requests sharing it, all of one fixed
+    # size (picked by a leading constant: iRobot's sensor queries, 8E and a packet id)
+    sized: dict[str, Message] = field(default_factory=dict)
     expected: list[tuple[str, str, str]] = field(default_factory=list)
     dispatchers: list[dict[str, Any]] = field(default_factory=list)
     size_dispatchers: list[dict[str, Any]] = field(default_factory=list)
@@ -161,6 +165,10 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         found.sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
         if len(users) == 1 and users[0][0] is not None:
             found.single[key] = users[0][0]
+        messages = [m for m, _, _, _ in users if m is not None]
+        sizing = sizing_message(messages) if len(messages) == len(users) else None
+        if sizing is not None:
+            found.sized[key] = sizing
         if direction == Direction.RESPONSE:
             found.expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
     return found

@@ -524,6 +524,10 @@ class Commands(FieldResolver):
                     continue  # replies without a code read in the layout of their request: chosen by it
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
                 if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
+                    picked = discriminator([m for _, m in users])
+                    sizes = {(m.min_size, m.max_size) for _, m in users}
+                    if picked is not None and len(sizes) == 1 and len({size for pair in sizes for size in pair}) == 1:
+                        continue  # one fixed size, picked by a leading constant: no length needed (iRobot's sensors)
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
                         shared = (
                             f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "

@@ -128,6 +128,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         dispatchers += table.dispatchers
         size_dispatchers += table.size_dispatchers
         dispatch, sizes, single, expected = table.dispatch, table.sizes, table.single, table.expected
+        sized = {key: single.get(key) or table.sized[key] for key, _ in dispatch if key in single or key in table.sized}
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
         requesting = protocol.framing.requesting
@@ -156,8 +157,8 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
             answering = [m for m in protocol.messages() if m.direction == direction]
             sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]
-            single = {repr(m.class_name): m for m in answering}
-        frame_codec, used = codec_lines(protocol, direction, sizes, single)
+            sized = {repr(m.class_name): m for m in answering}
+        frame_codec, used = codec_lines(protocol, direction, sizes, sized)
         if refusals:  # the classes the frame engine names (Unwrapped.reply)
             shown = ", ".join(f"{name!r}: {name}" for name in refusals)
             frame_codec = [f"_{direction.name}_REFUSALS: dict[str, type[Message]] = {{{shown}}}", *frame_codec]

@@ -6,6 +6,7 @@ headerless one; each mistake in such a spec is one line at its place."""
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -159,3 +160,39 @@ def does_not_fit(data: dict[str, Any]) -> None:
 def test_each_mistake_is_one_line(tmp_path: Path, change: Any, said: str) -> None:
     found = errors_of(tmp_path, change)
     assert any(said in line for line in found), found
+
+
+PLAIN_FRAMES = ["84 02 70 2e", "aa 84 05 01 02", "90 03", "aa 90 07", "a2", "aa a2"]
+
+
+def test_the_c_reads_a_headerless_layout_beside_a_headed_one(tmp_path: Path) -> None:
+    """The Pololu form sending its codes as they are: the C takes a frame in the layout its header names, the
+    headerless one last, as Python does (it took `aa 84 05 01 02` in the headerless layout: unknown command 0xaa),
+    and its parser gives Python's messages and counts however the bytes come."""
+    from serialspec.cli import main
+    from test_c_backend import GCC, Driver
+
+    if GCC is None:
+        pytest.skip("no C compiler")
+    data = copy.deepcopy(SPEC)
+    del elements(data, "pololu")["command"]["code"]
+    data["protocol"] = "plain_forms"  # (not the module `forms` imported)
+    spec = write(tmp_path, data)
+    assert main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
+    package = generate_and_import(spec, tmp_path / "py", "plain_forms")
+    driver = Driver("plain_forms", tmp_path / "out" / "c" / "plain_forms", tmp_path)
+    try:
+        for frame in PLAIN_FRAMES:
+            said = driver.ask(f"dec request {frame.replace(' ', '')}")[0]
+            message = package.decode(bytes.fromhex(frame), package.Direction.REQUEST)
+            assert said.startswith("ok ") and json.loads(said[3:])["fields"] == message.to_fields(), frame
+        stream = bytes.fromhex(" ".join([*PLAIN_FRAMES, "aa aa", *PLAIN_FRAMES]))
+        for cut in (1, 3):
+            lines = driver.ask(f"stream request {cut} {stream.hex()}")
+            parser = package.StreamParser(package.Direction.REQUEST)
+            found = [m for i in range(0, len(stream), cut) for m in parser.feed(stream[i : i + cut])]
+            got = [json.loads(line[4:])["fields"] for line in lines if line.startswith("msg ")]
+            assert got == [m.to_fields() for m in found] and len(found) == 12
+            assert lines[-1] == f"end 12 {parser.garbage} {parser.errors} 0"
+    finally:
+        driver.close()

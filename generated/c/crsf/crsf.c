@@ -1576,9 +1576,15 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
     k = 0u;
     if (!CRSF__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = crsf__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = crsf__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && crsf__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1586,7 +1592,7 @@ int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, c
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? CRSF_E_LENGTH : CRSF_E_FRAME;
         }
     }

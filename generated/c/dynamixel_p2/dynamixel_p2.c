@@ -1307,9 +1307,15 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     k = 0u;
     if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = dynamixel_p2__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = dynamixel_p2__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && dynamixel_p2__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1317,7 +1323,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? DYNAMIXEL_P2_E_LENGTH : DYNAMIXEL_P2_E_FRAME;
         }
     }

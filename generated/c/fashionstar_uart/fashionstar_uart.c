@@ -2394,9 +2394,15 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     k = 0u;
     if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = fashionstar_uart__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = fashionstar_uart__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && fashionstar_uart__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -2404,7 +2410,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? FASHIONSTAR_UART_E_LENGTH : FASHIONSTAR_UART_E_FRAME;
         }
     }

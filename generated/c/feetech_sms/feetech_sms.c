@@ -1117,9 +1117,15 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     k = 0u;
     if (!FEETECH_SMS__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = feetech_sms__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = feetech_sms__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && feetech_sms__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1127,7 +1133,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? FEETECH_SMS_E_LENGTH : FEETECH_SMS_E_FRAME;
         }
     }

@@ -2313,9 +2313,15 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     k = 0u;
     if (!HIWONDER_RRC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = hiwonder_rrc__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = hiwonder_rrc__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && hiwonder_rrc__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -2323,7 +2329,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? HIWONDER_RRC_E_LENGTH : HIWONDER_RRC_E_FRAME;
         }
     }

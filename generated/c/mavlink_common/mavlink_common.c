@@ -1880,9 +1880,15 @@ int mavlink_common_decode_expect(const uint8_t *frame, size_t len, mavlink_commo
     k = 0u;
     if (!MAVLINK_COMMON__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = mavlink_common__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = mavlink_common__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && mavlink_common__same(frame, h, hl)) {
                 headed = 1;
                 if (mavlink_common__admits(dir, k, frame, len)) {
@@ -1890,7 +1896,7 @@ int mavlink_common_decode_expect(const uint8_t *frame, size_t len, mavlink_commo
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? MAVLINK_COMMON_E_LENGTH : MAVLINK_COMMON_E_FRAME;
         }
     }

@@ -1608,9 +1608,15 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     k = 0u;
     if (!MODBUS_RTU__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = modbus_rtu__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = modbus_rtu__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && modbus_rtu__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1618,7 +1624,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? MODBUS_RTU_E_LENGTH : MODBUS_RTU_E_FRAME;
         }
     }

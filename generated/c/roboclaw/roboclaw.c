@@ -2378,10 +2378,13 @@ static int roboclaw__decode_with(const uint8_t *frame, size_t len, roboclaw_dire
         }
     } else {
         int problem = ROBOCLAW_OK, elsewhere = ROBOCLAW_OK;
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then those without */
             size_t hl;
-            const uint8_t *h = roboclaw__header(dir, k, &hl);
-            if (hl > len || !roboclaw__same(frame, h, hl)) {
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = roboclaw__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count) || hl > len || !roboclaw__same(frame, h, hl)) {
                 continue;
             }
             r = roboclaw__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen, pre, pre_n);
@@ -2397,7 +2400,7 @@ static int roboclaw__decode_with(const uint8_t *frame, size_t len, roboclaw_dire
             }
             elsewhere = elsewhere != ROBOCLAW_OK ? elsewhere : ROBOCLAW_E_UNKNOWN; /* a code sent in another layout */
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return problem != ROBOCLAW_OK ? problem : elsewhere != ROBOCLAW_OK ? elsewhere : ROBOCLAW_E_FRAME;
         }
     }

@@ -1532,9 +1532,15 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
     k = 0u;
     if (!UBX__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = ubx__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = ubx__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && ubx__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1542,7 +1548,7 @@ int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? UBX_E_LENGTH : UBX_E_FRAME;
         }
     }

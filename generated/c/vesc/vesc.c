@@ -1577,9 +1577,15 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     k = 0u;
     if (!VESC__SINGLE && count != 1u) {
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) { /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = vesc__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = vesc__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {
+                continue;
+            }
             if (hl <= len && vesc__same(frame, h, hl)) {
                 headed = 1;
                 if (1) {
@@ -1587,7 +1593,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
                 }
             }
         }
-        if (k == count) {
+        if (i == 2u * count) {
             return headed ? VESC_E_LENGTH : VESC_E_FRAME;
         }
     }

@@ -1284,9 +1284,15 @@ static size_t {p}__least({p}_direction_t dir)
     taking = f"""    k = 0u;
     if (!{P}__SINGLE && count != 1u) {{
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
-        for (k = 0u; k < count; k++) {{
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) {{ /* those with a header first, then one without (FrameCodec.layout_of) */
             size_t hl;
-            const uint8_t *h = {p}__header(dir, k, &hl);
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = {p}__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count)) {{
+                continue;
+            }}
             if (hl <= len && {p}__same(frame, h, hl)) {{
                 headed = 1;
                 if ({admits}) {{
@@ -1294,7 +1300,7 @@ static size_t {p}__least({p}_direction_t dir)
                 }}
             }}
         }}
-        if (k == count) {{
+        if (i == 2u * count) {{
             return headed ? {P}_E_LENGTH : {P}_E_FRAME;
         }}
     }}
@@ -1307,10 +1313,13 @@ static size_t {p}__least({p}_direction_t dir)
         # of the layout that sends the frame's code first, then any layout's, then a code sent in another layout
         taking = f"""    {{
         int problem = {P}_OK, elsewhere = {P}_OK;
-        for (k = 0u; k < count; k++) {{
+        unsigned i;
+        for (i = 0u; i < 2u * count; i++) {{ /* those with a header first, then those without */
             size_t hl;
-            const uint8_t *h = {p}__header(dir, k, &hl);
-            if (hl > len || !{p}__same(frame, h, hl)) {{
+            const uint8_t *h;
+            k = (uint8_t)(i % count);
+            h = {p}__header(dir, k, &hl);
+            if ((hl == 0u) == (i < count) || hl > len || !{p}__same(frame, h, hl)) {{
                 continue;
             }}
             r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
@@ -1326,7 +1335,7 @@ static size_t {p}__least({p}_direction_t dir)
             }}
             elsewhere = elsewhere != {P}_OK ? elsewhere : {P}_E_UNKNOWN; /* a code sent in another layout */
         }}
-        if (k == count) {{
+        if (i == 2u * count) {{
             return problem != {P}_OK ? problem : elsewhere != {P}_OK ? elsewhere : {P}_E_FRAME;
         }}
     }}"""

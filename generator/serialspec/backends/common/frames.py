@@ -123,15 +123,12 @@ def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, .
 
 
 def refuse_code_forms(protocol: Protocol) -> None:
-    """Unsupported for a layout whose frames carry an expression of the command's code (`code:`) or a headerless
-    layout beside headed ones, in a target that does not do them (the C decoder)."""
+    """Unsupported for a layout whose frames carry an expression of the command's code (`code:`), in a target that
+    does not do them (the C decoder)."""
     layouts = [(layout, len(found)) for found in protocol.framing.alternatives.values() for layout in found]
     for layout, _ in layouts:
         if any(e.code for e in layout.elements if e.role == "command"):
             raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
-    for layout, alternatives in layouts:
-        if alternatives > 1 and not layout.header and not protocol.framing.by_command:
-            raise Unsupported(f"a layout without a header beside layouts with one (layout {layout.name})")
 
 
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:

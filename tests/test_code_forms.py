@@ -165,28 +165,35 @@ def test_each_mistake_is_one_line(tmp_path: Path, change: Any, said: str) -> Non
 PLAIN_FRAMES = ["84 02 70 2e", "aa 84 05 01 02", "90 03", "aa 90 07", "a2", "aa a2"]
 
 
-def test_the_c_reads_a_headerless_layout_beside_a_headed_one(tmp_path: Path) -> None:
-    """The Pololu form sending its codes as they are: the C takes a frame in the layout its header names, the
-    headerless one last, as Python does (it took `aa 84 05 01 02` in the headerless layout: unknown command 0xaa),
-    and its parser gives Python's messages and counts however the bytes come."""
+@pytest.mark.parametrize("expression", [True, False], ids=["code & 0x7F", "codes as they are"])
+def test_the_c_reads_both_forms(tmp_path: Path, expression: bool) -> None:
+    """The C takes a frame in the layout its header names, the headerless one last, as Python does (it took
+    `aa 84 05 01 02` in the headerless layout: unknown command 0xaa), and translates a code sent as an expression of
+    it (it refused the spec); its decoder, encoder and parser give Python's messages, frames and counts."""
     from serialspec.cli import main
     from test_c_backend import GCC, Driver
 
     if GCC is None:
         pytest.skip("no C compiler")
     data = copy.deepcopy(SPEC)
-    del elements(data, "pololu")["command"]["code"]
-    data["protocol"] = "plain_forms"  # (not the module `forms` imported)
+    name = "coded_forms" if expression else "plain_forms"  # (not the module `forms` imported)
+    data["protocol"] = name
+    frames = [frame for frame, _ in FRAMES]
+    if not expression:
+        del elements(data, "pololu")["command"]["code"]
+        frames = PLAIN_FRAMES
     spec = write(tmp_path, data)
     assert main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
-    package = generate_and_import(spec, tmp_path / "py", "plain_forms")
-    driver = Driver("plain_forms", tmp_path / "out" / "c" / "plain_forms", tmp_path)
+    package = generate_and_import(spec, tmp_path / "py", name)
+    driver = Driver(name, tmp_path / "out" / "c" / name, tmp_path)
     try:
-        for frame in PLAIN_FRAMES:
-            said = driver.ask(f"dec request {frame.replace(' ', '')}")[0]
+        for frame in frames:
+            said = driver.ask(f"rt request {frame.replace(' ', '')}")[0]
             message = package.decode(bytes.fromhex(frame), package.Direction.REQUEST)
-            assert said.startswith("ok ") and json.loads(said[3:])["fields"] == message.to_fields(), frame
-        stream = bytes.fromhex(" ".join([*PLAIN_FRAMES, "aa aa", *PLAIN_FRAMES]))
+            assert said == f"ok {package.encode(message).hex()}", frame
+        if expression:  # 0x84 is no code of the Pololu form (the Python codec: "command = 0x84 is no code of...")
+            assert driver.ask("dec request aa8402")[0] == "err E_UNKNOWN"
+        stream = bytes.fromhex(" ".join([*frames, "aa aa", *frames]))
         for cut in (1, 3):
             lines = driver.ask(f"stream request {cut} {stream.hex()}")
             parser = package.StreamParser(package.Direction.REQUEST)
@@ -194,5 +201,48 @@ def test_the_c_reads_a_headerless_layout_beside_a_headed_one(tmp_path: Path) -> 
             got = [json.loads(line[4:])["fields"] for line in lines if line.startswith("msg ")]
             assert got == [m.to_fields() for m in found] and len(found) == 12
             assert lines[-1] == f"end 12 {parser.garbage} {parser.errors} 0"
+    finally:
+        driver.close()
+
+
+WIDE = """
+protocol: wide_forms
+title: A code only the second layout's command element holds, sent there as an expression of it
+byte_order: little
+serial: {baudrate: 9600}
+framing:
+  layouts:
+    short:
+      elements:
+        code: {role: command, type: u8}
+        content: {role: content}
+    long:
+      elements:
+        start: {role: header, value: F0}
+        code: {role: command, type: u16, code: "code | 0x8000"}
+        content: {role: content}
+commands:
+  small: {code: 0x10, request: {fields: {a: u8}}}
+  big: {code: 0x1234, request: {fields: {b: u16}}}
+"""
+
+
+def test_the_c_sends_a_code_in_the_layout_that_holds_it_as_its_expression(tmp_path: Path) -> None:
+    from serialspec.cli import main
+    from test_c_backend import GCC, Driver
+
+    if GCC is None:
+        pytest.skip("no C compiler")
+    spec = tmp_path / "wide_forms.yaml"
+    spec.write_text(WIDE, "utf-8")
+    assert main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
+    package = generate_and_import(spec, tmp_path / "py", "wide_forms")
+    big = package.encode(package.BigRequest(b=7))
+    assert big == bytes.fromhex("f0 34 92 07 00")  # 0x1234 | 0x8000, little-endian
+    driver = Driver("wide_forms", tmp_path / "out" / "c" / "wide_forms", tmp_path)
+    try:
+        assert driver.ask(f"rt request {big.hex()}") == [f"ok {big.hex()}"]  # decoded, then encoded in `long`
+        assert driver.ask("rt request 1003") == ["ok 1003"]
+        assert driver.ask("dec request f0341207") == ["err E_UNKNOWN"]  # 0x1234 itself is no code sent in `long`
     finally:
         driver.close()

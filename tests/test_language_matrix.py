@@ -1030,7 +1030,6 @@ CASES[FORMS] = Case(
     },
     commands={"other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"fields": {"b": "i16"}}}},
 )
-C_REFUSES[FORMS] = "an expression of the code (`code:`"
 
 
 # `every` as an expression of the device's values (a rate the request sets): the beats come among the replies

@@ -218,7 +218,9 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
     refuse_by_request(protocol)
-    refuse_code_forms(protocol)
+    from serialspec.backends.c import length_byte  # (which imports this module)
+
+    refuse_code_forms(protocol, length_byte.applies(protocol))
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

@@ -627,7 +627,12 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             code = f"(({value}) & {flag}UL) != 0u ? {P}__ERROR_CODE : (long)({value})" if flag else f"(long)({value})"
             if layout.error:  # an error header's layout (`error_value`): the refused request's code
                 code = f"{P}__ERROR_CODE"
-            lines.append(f"    code = {code}; /* {e.name} */")
+            if e.wire:  # it sends an expression of the code: the code it stands for (none: no frame)
+                code = f"{p}__code_{direction.value}_{k}({value})"
+                lines.append(f"    code = {code}; /* {e.name}: {comment(e.code)} */")
+                lines.append(f"    if (code < 0L) {{ return {P}__NONE; }}")
+            else:
+                lines.append(f"    code = {code}; /* {e.name} */")
             lines.append(
                 f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
             )
@@ -841,7 +846,13 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
     v = 0
     for i, e in enumerate(elements):
         value = _wire_value(start[i], sizes[i], e.endian == ">")
-        if e.role == "command":
+        if e.role == "command" and e.wire:  # an expression of the code: the code it stands for
+            lines += [
+                f"    {{ long sent = {p}__code_{direction.value}_{k}({value}); /* {e.name}: {comment(e.code)} */",
+                f"      if (sent < 0L) {{ return {P}_E_UNKNOWN; }} /* no code of layout {layout.name} */",
+                "      *code = (uint32_t)sent; }",
+            ]
+        elif e.role == "command":
             lines.append(f"    *code = {value}; /* {e.name} */")
         elif e.role in VALUE_ROLES:
             assert e.type is not None
@@ -1229,6 +1240,7 @@ def source(ctx: Ctx) -> str:
                 f"int {p}_encode_{mid}(const {p}_{mid}_t *m, uint8_t *buf, size_t cap, size_t *len)\n"
                 f"{{\n    return {p}__encode_{mid}(m, NULL, 0u, buf, cap, len);\n}}\n"
             )
+    sending, sent = wire_sending(ctx)  # codes sent as an expression of them (`code:`)
     enc_cases = "\n".join(
         f"#if {P}_ENCODES_{m.direction.name}S\n"
         f"    case {kind_name(ctx, m)}:\n        return {p}_encode_{msg_id(m)}(&msg->u.{msg_id(m)}, buf, cap, len);\n"
@@ -1471,7 +1483,7 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
 }}
 
 """
-    probing = (
+    probing = wire_codes(ctx) + (
         "/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */\n"
     )
     probing += "".join(
@@ -1651,8 +1663,8 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
             room = cap - before;
         }}
         r = enc(m, dst, room, &clen);
-        if (r == {P}_OK) {{
-            r = {p}__wrap(L, buf, cap, span, clen, code, values, {"extras" if opt else "NULL"}, len{pre_arg});
+        if (r == {P}_OK) {{{sending}
+            r = {p}__wrap(L, buf, cap, span, clen, {sent}, values, {"extras" if opt else "NULL"}, len{pre_arg});
         }}
         if (r == {P}_OK) {{
             return r;
@@ -2636,3 +2648,55 @@ def json_integers(p: str, suffix: str, bits: int) -> list[tuple[str, str]]:
 
 """
     return [(f"wu{suffix}", unsigned), (f"wi{suffix}", signed)]
+
+
+def wire_layouts(ctx: Ctx) -> list[tuple[Direction, int, FrameLayout, FrameElement]]:
+    """The layouts whose command element sends an expression of the code (`code:`), with that element."""
+    return [
+        (d, k, layout, e)
+        for d in directions(ctx.protocol)
+        for k, layout in enumerate(ctx.protocol.framing.alternatives[d])
+        for e in layout.elements
+        if e.role == "command" and e.wire
+    ]
+
+
+def wire_codes(ctx: Ctx) -> str:
+    """For each layout whose command element sends an expression of the code (`code:`, the Maestro's Pololu form:
+    `code & 0x7F`): the code a value sent stands for, -1 for none (runtime/framing.py Layout.from_wire)."""
+    p = ctx.p
+    functions = []
+    for d, k, layout, e in wire_layouts(ctx):
+        cases = "\n".join(f"    case {sent}UL:\n        return {code}L;" for code, sent in e.wire)
+        functions.append(
+            f"""/* {e.name} of layout {layout.name} ({d.value}s) sends {comment(e.code)}: a value's code (-1: none) */
+static long {p}__code_{d.value}_{k}(uint32_t sent)
+{{
+    switch (sent) {{
+{cases}
+    default:
+        return -1L;
+    }}
+}}
+"""
+        )
+    return "\n".join(functions)
+
+
+def wire_sending(ctx: Ctx) -> tuple[str, str]:
+    """{p}__frame's lines that give the value a layout's command element sends for the code (Layout.to_wire), and
+    the name of that value; a layout that does not send the code is skipped, as Python tries the next."""
+    P = ctx.P
+    found = wire_layouts(ctx)
+    if not found:
+        return "", "code"
+    cases = []
+    for d, k, _, e in found:
+        sent = " ".join(f"case {code}UL: sent = {value}UL; break;" for code, value in e.wire)
+        cases.append(
+            f"            if (dir == {P}_{d.name} && k == {k}u) {{ /* {e.name}: {comment(e.code)} */\n"
+            f"                switch (code) {{ {sent} default: r = {P}_E_RANGE; continue; }}\n"
+            "            }"
+        )
+    lines = "\n            uint32_t sent = code;\n" + "\n".join(cases)
+    return lines, "sent"

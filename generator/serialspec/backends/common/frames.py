@@ -122,13 +122,19 @@ def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, .
     )
 
 
-def refuse_code_forms(protocol: Protocol) -> None:
-    """Unsupported for a layout whose frames carry an expression of the command's code (`code:`), in a target that
-    does not do them (the C decoder)."""
-    layouts = [(layout, len(found)) for found in protocol.framing.alternatives.values() for layout in found]
-    for layout, _ in layouts:
-        if any(e.code for e in layout.elements if e.role == "command"):
-            raise Unsupported(f"a command element sending an expression of the code (`code:`, layout {layout.name})")
+def refuse_code_forms(protocol: Protocol, length_byte: bool) -> None:
+    """Unsupported for a command element sending an expression of the command's code (`code:`) where the C does not
+    translate it: in a transformed layout, in layouts chosen by command, or in frames of the length-byte shape
+    (`length_byte`: the C's own parser for them)."""
+    for found in protocol.framing.alternatives.values():
+        for layout in found:
+            if not any(e.code for e in layout.elements if e.role == "command"):
+                continue
+            if layout.transparency is not None or protocol.framing.by_command or length_byte:
+                raise Unsupported(
+                    f"a command element sending an expression of the code (`code:`, layout {layout.name}) in a "
+                    "layout with a transform, in layouts chosen by command or alone in its direction"
+                )
 
 
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:

@@ -63,6 +63,18 @@ def rename(path: str, new: str) -> Mutation:
     return mutate
 
 
+def _status_reply(count: int) -> Data:
+    """tiny's status reply with one value: an example recording its count (which encode computes) as given."""
+    fields = {"id": 1, "alarms": 0, "count": count, "values": [{"v": 258}]}
+    return {
+        "source": "made up",
+        "direction": "response",
+        "printed": "AA 55 01 04 04 00 01 02 01 0D",
+        "command": "status",
+        "fields": fields,
+    }
+
+
 def both(*mutations: Mutation) -> Mutation:
     def mutate(data: Data) -> None:
         for mutation in mutations:
@@ -1194,6 +1206,18 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "tiny",
         put("examples/move_request/fields/speed", 1),
         "examples.move_request: the frame decodes to other values: speed is not in the frame",
+    ),
+    (
+        "example records a computed count as the frame holds it",  # documents print counts and constants
+        "tiny",
+        put("examples/status_reply", _status_reply(count=1)),
+        None,
+    ),
+    (
+        "example records a computed count wrong",
+        "tiny",
+        put("examples/status_reply", _status_reply(count=2)),
+        "examples.status_reply: the frame decodes to other values: status response: count is given as 2, but it is computed: 1 (leave it out)",
     ),
     (
         "example of another command",

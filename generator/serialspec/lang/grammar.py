@@ -1208,7 +1208,11 @@ EXAMPLE = Obj(
         "command": Str("The command the frame decodes as."),
         "subcommand": Str("Its sub-command, where the command has them."),
         "request": Str("Name of the example whose request this example answers."),
-        "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
+        "fields": MapOf(
+            Any_(),
+            "The field values the frame carries (raw wire values); a value encode computes (a `const`, a count, a "
+            "`value:` expression), which messages leave out, may be recorded too, as the frame holds it.",
+        ),
     },
     required=("source", "direction", "printed", "command", "fields"),
     description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",

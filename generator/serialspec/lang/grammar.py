@@ -662,7 +662,8 @@ COMMAND = Obj(
             "commands may share a code when no content size fits two of them: each is its own message, "
             "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
             "with a constant field of one width, no two equal: each is picked by that value before its size "
-            "(below, RTCM 3's message number). Frames without a command element share the same way.",
+            "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
+            "its message is known). Frames without a command element share the same way.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,

@@ -45,6 +45,7 @@ from serialspec.backends.python.kinds import (
     fixed_runs,
     is_fixed_run_member,
     kind,
+    one_order,
     run_endian,
     struct_format,
     struct_tokens,
@@ -732,8 +733,8 @@ class PackageCode:
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
         start_list = Code(f"{value}_list = []")
         body.append(start_list)
-        if f.item_size is not None and all(is_fixed_run_member(i) for i in item_fields):  # one struct per item
-            item_fmt = struct_format(self.protocol_endian(), item_fields)
+        if f.item_size is not None and all(map(is_fixed_run_member, item_fields)) and one_order(item_fields):
+            item_fmt = struct_format(run_endian(item_fields), item_fields)  # one struct per item
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
                 reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
@@ -854,9 +855,6 @@ class PackageCode:
 
     def local_named(self, name: str) -> str:
         return f"v_{name}"
-
-    def protocol_endian(self) -> str:
-        return ">" if self.protocol.byte_order == "big" else "<"
 
     # --- encoding -------------------------------------------------------------------------------------------------
 

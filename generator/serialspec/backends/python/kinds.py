@@ -456,13 +456,30 @@ def takes_the_rest(f: SpecField | None) -> bool:
 # --- runs of fixed-size fields (one struct call each) ---------------------------------------------------------------
 
 
+def struct_order(f: SpecField) -> str | None:
+    """The struct byte order a fixed-size field is read in, None where none matters (single bytes; a 3-byte scalar
+    is read as bytes and converted in its own byte order)."""
+    if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
+        return None if byte_order_free(kind(f).struct_chars(f)) else f.endian
+    return None
+
+
 def run_endian(fields: list[SpecField]) -> str:
-    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
+    """The struct byte order of a run of fixed-size fields: its multi-byte fields' (fixed_runs keeps one a run), else
+    its first field's that has one (single bytes: either order reads them)."""
+    order = next((o for o in map(struct_order, fields) if o is not None), None)
+    if order is not None:
+        return order
     for f in fields:
-        # a 3-byte scalar is read as bytes and converted in its own byte order
         if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
             return f.endian
     return "<"
+
+
+def one_order(fields: list[SpecField]) -> bool:
+    """Whether fixed-size fields can be one struct: their multi-byte ones have one byte order (a big-endian device
+    id after little-endian values, SDS011's, cannot)."""
+    return len({struct_order(f) for f in fields} - {None}) <= 1
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
@@ -497,6 +514,9 @@ def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]
     run: list[SpecField] = []
     for f in fields:
         if is_fixed_run_member(f):
+            if not one_order([*run, f]):  # a field in another byte order starts a run of its own
+                yield run
+                run = []
             run.append(f)
             continue
         if run:

@@ -41,6 +41,7 @@ from serialspec.backends.python.kinds import (
     byte_order_free,
     fixed_runs,
     is_fixed_run_member,
+    one_order,
     run_endian,
     struct_format,
 )
@@ -493,7 +494,7 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
         body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
         return body
     code = str(command_code if command_code is not None else 0)
-    if all(is_fixed_run_member(f) for f in fields):
+    if all(is_fixed_run_member(f) for f in fields) and one_order(fields):
         # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
         endian, content_format, args = package.encode_run_format(fields, "m", fields, body, where)
         head = head_struct(package, layout, endian, code, message.min_size + layout.length_adds, frame_values)

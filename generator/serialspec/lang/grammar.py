@@ -378,7 +378,8 @@ def bit_fields(description: str) -> MapOf:
                             "whose every bit field has a `const` or `default` (a frame element's: a sync byte) needs "
                             "no argument: message classes and client methods default it to the bits class's preset "
                             "(`SYNC_BITS_PRESET`); later parameters without a default stay positional and are "
-                            "refused (TypeError) when left out.",
+                            "refused (TypeError) when left out. JSON (`serialspec encode --json`, `from_fields`) "
+                            "may likewise leave out such a value, or any bit field with a `const` or `default`.",
                             example=0,
                         ),
                         "description": TEXT,
@@ -693,7 +694,10 @@ COMMAND = Obj(
             "frames told apart by their header (TFmini: data frames `59 59` with no command byte, `measurement: "
             "{layout: data}`, beside configuration frames `42 57 02 00`, parameters, the command byte last, "
             "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
-            "with no length, is found by trying each code's size. The C decoder takes such a spec where each frame "
+            "with no length, is found by trying each code's size. They may also carry different frame values (an "
+            "`address`, `status` or `value` one layout has and another has not: RPLIDAR's response descriptor beside "
+            "its headerless measurements): each message carries its own layout's (the C target refuses such a "
+            "spec, saying so). The C decoder takes such a spec where each frame "
             "says how to read it (replies through `p_decode_reply` with their request); the Wireshark dissector "
             "reads a reply with the last request before it in the capture, and marks one whose request is not in "
             "the capture (expert note `Request not in capture`).",

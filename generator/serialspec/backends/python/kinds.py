@@ -194,6 +194,8 @@ class ScalarKind(Kind[Scalar]):
     def from_json(self, f: Scalar) -> Calls:
         get = _get(f)
         if f.bits:
+            if all(b.preset is not None for b in f.bits):  # every bit field filled in: the value may be left out
+                get = Calls(f"data.get({spec_key(f.name)}, {{}})", [])
             # errors inside name the field too: "spin request method: direction must be an integer"
             text = f"{f.bits_class}.from_fields(_mapping({get}, {spec_key(f.name)}, where), where + {' ' + f.name!r})"
             return Calls(text, ["_mapping"], get)

@@ -489,7 +489,15 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             body.append(Code(wrap, lists=packed_lists(parts)))
             return body
         if framing.requesting:  # its layout, and the request a reply answers
-            arguments += f", {layout_index(package.protocol, message)}, request"
+            index = layout_index(package.protocol, message)
+            first = framing.layouts[message.direction]
+            if [e.name for e in layout.value_elements] != [e.name for e in first.value_elements]:
+                # layouts chosen by command with values of their own: the engine takes this layout's
+                values = f"({', '.join(frame_values)},)" if frame_values else "()"
+                wrap = f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values}, {index}, "
+                body.append(Code(f"{wrap}_request_parts(request){extras})", lists=packed_lists(parts)))
+                return body
+            arguments += f", {index}, request"
         arguments += extras
         body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
         return body

@@ -8,6 +8,7 @@ references that resolve, sizes that add up) is checked later, in resolve.py.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import field
 from typing import Any, assert_never
@@ -225,7 +226,11 @@ class Obj(Shape):
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
             if shape is None:
-                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)})"
+                # no key of the language holds a space or punctuation: such a "key" is most likely the rest of a
+                # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
+                cut = isinstance(key, str) and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", key)
+                hint = "; a comma inside `{...}` ends a value: quote text that holds one" if cut else ""
+                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)}{hint})"
             else:
                 yield from shape.check(item, (*path, key))
 

@@ -63,6 +63,18 @@ def rename(path: str, new: str) -> Mutation:
     return mutate
 
 
+def _status_reply(count: int) -> Data:
+    """tiny's status reply with one value: an example recording its count (which encode computes) as given."""
+    fields = {"id": 1, "alarms": 0, "count": count, "values": [{"v": 258}]}
+    return {
+        "source": "made up",
+        "direction": "response",
+        "printed": "AA 55 01 04 04 00 01 02 01 0D",
+        "command": "status",
+        "fields": fields,
+    }
+
+
 def both(*mutations: Mutation) -> Mutation:
     def mutate(data: Data) -> None:
         for mutation in mutations:
@@ -1194,6 +1206,24 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "tiny",
         put("examples/move_request/fields/speed", 1),
         "examples.move_request: the frame decodes to other values: speed is not in the frame",
+    ),
+    (
+        "a comma in flow-style text",  # the rest of the text after the comma reads as a key
+        "tiny",
+        replace_text('unit: "0.1°"', "unit: tenths, of a degree"),
+        "commands.move.request.fields.angle.of a degree: unknown key 'of a degree' (expected one of type, use, label, description, description_cn, unit, scale, offset, range, const, default, enum, flags, bits, encoding, endian, size, count, of, bit_order, pad, count_from, value, fields, table, key, start, size_from, select, expect_size, inferred, precision, width, letters, max_count, status; a comma inside `{...}` ends a value: quote text that holds one)",
+    ),
+    (
+        "example records a computed count as the frame holds it",  # documents print counts and constants
+        "tiny",
+        put("examples/status_reply", _status_reply(count=1)),
+        None,
+    ),
+    (
+        "example records a computed count wrong",
+        "tiny",
+        put("examples/status_reply", _status_reply(count=2)),
+        "examples.status_reply: the frame decodes to other values: status response: count is given as 2, but it is computed: 1 (leave it out)",
     ),
     (
         "example of another command",

@@ -174,7 +174,7 @@ def list_value(
 
 
 def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[dict[str, Any]]:
-    frame = protocol.framing.layouts[message.direction].value_elements
+    frame = protocol.layout(message).value_elements
     frame_values = st.fixed_dictionaries(
         {
             e.name: st.fixed_dictionaries({b.name: bit_values(b) for b in e.bits})

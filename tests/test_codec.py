@@ -80,7 +80,7 @@ def check_against_construct(
     content = frame_content(g, frame, spec.direction.value, context)
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
     parsed = spec_names(plain(content_struct.parse(content)))
-    layout = g.protocol.framing.layouts[spec.direction]
+    layout = g.protocol.layout(spec)  # its own layout's values (layouts chosen by command may differ)
     frame_names = {e.name for e in (*layout.value_elements, *layout.optional)}  # the frame's, not the content's
     error = g.protocol.error_reply
     if spec.error_reply and error is not None:

@@ -1000,6 +1000,16 @@ CASES[MIXED] = Case(
     },
 )
 
+# Layouts chosen by command with frame values of their own (RPLIDAR: the response descriptor's size and mode beside
+# headerless measurements that carry none): each message carries its own layout's values
+OWN_VALUES = "frame: layouts chosen by command, a frame value one layout has and another has not"
+CASES[OWN_VALUES] = copy.deepcopy(CASES[MIXED])
+_data = CASES[OWN_VALUES].framing["layouts"]["data"]["elements"]
+_data["seq"] = {"role": "value", "type": "u8", "range": [0, 99]}
+_data["content"] = _data.pop("content")
+_data["sum"] = _data.pop("sum")
+C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
+
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a
 # header, its code plain, tried last; one after a header, its code an expression of the command's (`code:`)

@@ -8,6 +8,7 @@ references that resolve, sizes that add up) is checked later, in resolve.py.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import field
 from typing import Any, assert_never
@@ -225,7 +226,11 @@ class Obj(Shape):
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
             if shape is None:
-                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)})"
+                # no key of the language holds a space or punctuation: such a "key" is most likely the rest of a
+                # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
+                cut = isinstance(key, str) and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", key)
+                hint = "; a comma inside `{...}` ends a value: quote text that holds one" if cut else ""
+                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)}{hint})"
             else:
                 yield from shape.check(item, (*path, key))
 
@@ -378,7 +383,8 @@ def bit_fields(description: str) -> MapOf:
                             "whose every bit field has a `const` or `default` (a frame element's: a sync byte) needs "
                             "no argument: message classes and client methods default it to the bits class's preset "
                             "(`SYNC_BITS_PRESET`); later parameters without a default stay positional and are "
-                            "refused (TypeError) when left out.",
+                            "refused (TypeError) when left out. JSON (`serialspec encode --json`, `from_fields`) "
+                            "may likewise leave out such a value, or any bit field with a `const` or `default`.",
                             example=0,
                         ),
                         "description": TEXT,
@@ -666,7 +672,8 @@ COMMAND = Obj(
             "commands may share a code when no content size fits two of them: each is its own message, "
             "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
             "with a constant field of one width, no two equal: each is picked by that value before its size "
-            "(below, RTCM 3's message number). Frames without a command element share the same way.",
+            "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
+            "its message is known). Frames without a command element share the same way.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -696,7 +703,10 @@ COMMAND = Obj(
             "frames told apart by their header (TFmini: data frames `59 59` with no command byte, `measurement: "
             "{layout: data}`, beside configuration frames `42 57 02 00`, parameters, the command byte last, "
             "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
-            "with no length, is found by trying each code's size. The C decoder takes such a spec where each frame "
+            "with no length, is found by trying each code's size. They may also carry different frame values (an "
+            "`address`, `status` or `value` one layout has and another has not: RPLIDAR's response descriptor beside "
+            "its headerless measurements): each message carries its own layout's (the C target refuses such a "
+            "spec, saying so). The C decoder takes such a spec where each frame "
             "says how to read it (replies through `p_decode_reply` with their request); the Wireshark dissector "
             "reads a reply with the last request before it in the capture, and marks one whose request is not in "
             "the capture (expert note `Request not in capture`).",
@@ -1215,7 +1225,11 @@ EXAMPLE = Obj(
         "command": Str("The command the frame decodes as."),
         "subcommand": Str("Its sub-command, where the command has them."),
         "request": Str("Name of the example whose request this example answers."),
-        "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
+        "fields": MapOf(
+            Any_(),
+            "The field values the frame carries (raw wire values); a value encode computes (a `const`, a count, a "
+            "`value:` expression), which messages leave out, may be recorded too, as the frame holds it.",
+        ),
     },
     required=("source", "direction", "printed", "command", "fields"),
     description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",

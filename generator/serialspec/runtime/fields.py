@@ -11,12 +11,16 @@ from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import TYPE_CHECKING, Record, is_sequence
 
 
+class UnknownFieldError(EncodeError):
+    """A field the message does not have (check_keys): neither one of its own nor a value encode computes."""
+
+
 def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable[str], where: str) -> None:
     """Refuse unknown keys; `optional` keys (derived values such as counts) may be given and are ignored."""
     allowed = set(known) | set(optional)
     for key in data:
         if key not in allowed:
-            raise EncodeError(f"{where}: unknown field {key!r} (expected {', '.join(known) or 'no fields'})")
+            raise UnknownFieldError(f"{where}: unknown field {key!r} (expected {', '.join(known) or 'no fields'})")
 
 
 def check_given(data: Mapping[str, Any], name: str, compute: Callable[[], int], where: str) -> None:

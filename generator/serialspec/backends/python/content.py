@@ -45,6 +45,7 @@ from serialspec.backends.python.kinds import (
     fixed_runs,
     is_fixed_run_member,
     kind,
+    one_order,
     run_endian,
     struct_format,
     struct_tokens,
@@ -269,8 +270,9 @@ class PackageCode:
 
     def frame_values(self, direction: Direction, message: Message | None = None) -> list[Scalar]:
         """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields; an error reply
-        (Modbus exception) also carries the code of the request it refuses, named after the command element."""
-        layout = self.protocol.framing.layouts[direction]
+        (Modbus exception) also carries the code of the request it refuses, named after the command element. A
+        message's are those of its own layout (layouts chosen by command may carry different values)."""
+        layout = self.protocol.framing.layouts[direction] if message is None else self.protocol.layout(message)
         elements = list(layout.value_elements)
         error = self.protocol.error_reply
         if message is not None and message.error_reply and error is not None:
@@ -327,7 +329,9 @@ class PackageCode:
                 if all(b.preset is not None for b in f.bits):
                     code.default_name = preset_name(f.bits_class)
                 code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-                code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
+                code.read_from(
+                    [self.from_value_expr(b.name, b.enum.class_name if b.enum else None, b.preset) for b in f.bits]
+                )
                 self.helper_classes.append(code)
             case Group() if f.class_name not in self._seen_classes:
                 self._seen_classes.add(f.class_name)
@@ -354,7 +358,7 @@ class PackageCode:
                 ]
                 code.read_from(
                     [
-                        self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float)
+                        self.from_value_expr(e.name, e.enum.class_name if e.enum else None, is_float=e.type.is_float)
                         for e in f.entries
                     ]
                 )
@@ -364,13 +368,16 @@ class PackageCode:
             case _:
                 assert_never(f)
 
-    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> Calls:
-        """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""
-        get = f"_get(data, {name!r}, where)"
+    def from_value_expr(self, name: str, enum: str | None, preset: int | None = None, is_float: bool = False) -> Calls:
+        """A value of a bit field or table block entry, from data: an enum member or an integer (or a number); a bit
+        field with a constant or default (`preset`) may be left out, as the bits class leaves it out."""
+        get, uses = (
+            (f"_get(data, {name!r}, where)", ["_get"]) if preset is None else (f"data.get({name!r}, {preset})", [])
+        )
         if enum:
-            return Calls(f"_as_enum({enum}, {get}, {name!r}, where)", ["_as_enum", "_get"])
+            return Calls(f"_as_enum({enum}, {get}, {name!r}, where)", ["_as_enum", *uses])
         helper = "_number" if is_float else "_integer"
-        return Calls(f"{helper}({get}, {name!r}, where)", [helper, "_get"])
+        return Calls(f"{helper}({get}, {name!r}, where)", [helper, *uses])
 
     def to_json(self, f: SpecField, expr: str) -> str:
         return kind(f).to_json(f, expr)
@@ -379,7 +386,7 @@ class PackageCode:
         return kind(f).from_json(f)
 
     def message(self, message: Message) -> None:
-        for f in [*self.frame_values(message.direction), *message.fields]:
+        for f in [*self.frame_values(message.direction, message), *message.fields]:
             self.helper(f)
         fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
@@ -732,8 +739,8 @@ class PackageCode:
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
         start_list = Code(f"{value}_list = []")
         body.append(start_list)
-        if f.item_size is not None and all(is_fixed_run_member(i) for i in item_fields):  # one struct per item
-            item_fmt = struct_format(self.protocol_endian(), item_fields)
+        if f.item_size is not None and all(map(is_fixed_run_member, item_fields)) and one_order(item_fields):
+            item_fmt = struct_format(run_endian(item_fields), item_fields)  # one struct per item
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
                 reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
@@ -854,9 +861,6 @@ class PackageCode:
 
     def local_named(self, name: str) -> str:
         return f"v_{name}"
-
-    def protocol_endian(self) -> str:
-        return ">" if self.protocol.byte_order == "big" else "<"
 
     # --- encoding -------------------------------------------------------------------------------------------------
 

@@ -194,6 +194,8 @@ class ScalarKind(Kind[Scalar]):
     def from_json(self, f: Scalar) -> Calls:
         get = _get(f)
         if f.bits:
+            if all(b.preset is not None for b in f.bits):  # every bit field filled in: the value may be left out
+                get = Calls(f"data.get({spec_key(f.name)}, {{}})", [])
             # errors inside name the field too: "spin request method: direction must be an integer"
             text = f"{f.bits_class}.from_fields(_mapping({get}, {spec_key(f.name)}, where), where + {' ' + f.name!r})"
             return Calls(text, ["_mapping"], get)
@@ -456,13 +458,30 @@ def takes_the_rest(f: SpecField | None) -> bool:
 # --- runs of fixed-size fields (one struct call each) ---------------------------------------------------------------
 
 
+def struct_order(f: SpecField) -> str | None:
+    """The struct byte order a fixed-size field is read in, None where none matters (single bytes; a 3-byte scalar
+    is read as bytes and converted in its own byte order)."""
+    if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
+        return None if byte_order_free(kind(f).struct_chars(f)) else f.endian
+    return None
+
+
 def run_endian(fields: list[SpecField]) -> str:
-    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
+    """The struct byte order of a run of fixed-size fields: its multi-byte fields' (fixed_runs keeps one a run), else
+    its first field's that has one (single bytes: either order reads them)."""
+    order = next((o for o in map(struct_order, fields) if o is not None), None)
+    if order is not None:
+        return order
     for f in fields:
-        # a 3-byte scalar is read as bytes and converted in its own byte order
         if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
             return f.endian
     return "<"
+
+
+def one_order(fields: list[SpecField]) -> bool:
+    """Whether fixed-size fields can be one struct: their multi-byte ones have one byte order (a big-endian device
+    id after little-endian values, SDS011's, cannot)."""
+    return len({struct_order(f) for f in fields} - {None}) <= 1
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
@@ -497,6 +516,9 @@ def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]
     run: list[SpecField] = []
     for f in fields:
         if is_fixed_run_member(f):
+            if not one_order([*run, f]):  # a field in another byte order starts a run of its own
+                yield run
+                run = []
             run.append(f)
             continue
         if run:

@@ -16,6 +16,7 @@ from serialspec.checksums.crc import Crc, crc_function
 from serialspec.lang.errors import SpecError
 from serialspec.lang.model import Erratum, Example, Protocol, TextExample, TextFrame
 from serialspec.runtime.errors import SerialspecError
+from serialspec.runtime.fields import UnknownFieldError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.text import texts
 
@@ -30,6 +31,22 @@ def _difference(found: dict[str, Any], recorded: dict[str, object], message: obj
         if found.get(name, ...) != recorded.get(name, ...)
     ]
     return "; ".join(wrong)
+
+
+def _computed_given(message: Any, found: dict[str, Any], recorded: dict[str, object]) -> str | None:
+    """Where the recorded values are the message's and, beside them, values that encode computes and messages leave
+    out (a constant such as WitMotion's unlock key, a count, a `value:` expression), as a document prints them: ""
+    when each is the value the frame holds, as JSON may give them (`from_fields`), else the one-line refusal naming
+    the value; None where other values differ."""
+    if any(name not in recorded or recorded[name] != value for name, value in found.items()):
+        return None
+    try:
+        built = type(message).from_fields(recorded)
+    except UnknownFieldError:
+        return None
+    except SerialspecError as exc:
+        return f"the frame decodes to other values: {exc}"
+    return "" if built == message else None
 
 
 def _raw_hint(found: object, recorded: object) -> str:
@@ -74,7 +91,10 @@ class _Checker:
         # an optional frame element not sent (None) need not be recorded
         found_fields = {k: v for k, v in message.to_fields().items() if v is not None or k in fields}
         if found_fields != fields:
-            return f"the frame decodes to other values: {_difference(found_fields, fields, message)}"
+            refused = _computed_given(message, found_fields, fields)
+            if refused is None:
+                return f"the frame decodes to other values: {_difference(found_fields, fields, message)}"
+            return refused
         return ""
 
     def asked(self, example: Example) -> Any:

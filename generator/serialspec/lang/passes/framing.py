@@ -593,9 +593,15 @@ def distinct_layouts(layouts: list[FrameLayout]) -> list[FrameLayout]:
     compact and Pololu forms differ in requests only: their replies are one layout)."""
     kept: list[FrameLayout] = []
     for layout in layouts:
-        if not any(k.elements == layout.elements and k.transparency == layout.transparency for k in kept):
+        if not any(_in_direction(k) == _in_direction(layout) and k.transparency == layout.transparency for k in kept):
             kept.append(layout)
     return kept
+
+
+def _in_direction(layout: FrameLayout) -> tuple[FrameElement, ...]:
+    """A layout's elements as its direction sees them: which other directions an element is in does not matter
+    (Pixy2: the checksum of responses only, beside one that requests with a checksum have too)."""
+    return tuple(replace(e, directions=()) for e in layout.elements)
 
 
 def distinct_checksum_functions(alternatives: dict[Direction, list[FrameLayout]]) -> dict[Direction, list[FrameLayout]]:

@@ -41,6 +41,7 @@ from serialspec.backends.python.kinds import (
     byte_order_free,
     fixed_runs,
     is_fixed_run_member,
+    one_order,
     run_endian,
     struct_format,
 )
@@ -488,12 +489,20 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             body.append(Code(wrap, lists=packed_lists(parts)))
             return body
         if framing.requesting:  # its layout, and the request a reply answers
-            arguments += f", {layout_index(package.protocol, message)}, request"
+            index = layout_index(package.protocol, message)
+            first = framing.layouts[message.direction]
+            if [e.name for e in layout.value_elements] != [e.name for e in first.value_elements]:
+                # layouts chosen by command with values of their own: the engine takes this layout's
+                values = f"({', '.join(frame_values)},)" if frame_values else "()"
+                wrap = f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values}, {index}, "
+                body.append(Code(f"{wrap}_request_parts(request){extras})", lists=packed_lists(parts)))
+                return body
+            arguments += f", {index}, request"
         arguments += extras
         body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
         return body
     code = str(command_code if command_code is not None else 0)
-    if all(is_fixed_run_member(f) for f in fields):
+    if all(is_fixed_run_member(f) for f in fields) and one_order(fields):
         # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
         endian, content_format, args = package.encode_run_format(fields, "m", fields, body, where)
         head = head_struct(package, layout, endian, code, message.min_size + layout.length_adds, frame_values)

@@ -1,0 +1,171 @@
+"""Sensirion SHDLC, the SPS30's commands (tests/specs/shdlc_sps30.yaml), written from the user docs alone and
+checked against sensirion-shdlc-driver: its MOSI frame builder writes our golden requests (byte stuffing of 7E, 7D,
+11 and 13 included), its MISO frame builder parses the replies we encode (address, command, state, data), and replies
+made with its stuffing and checksum decode to the values it read. The datasheet's frames are the spec's examples.
+Two gaps are strict xfails: replies that share a code told apart by their size (Read Measured Values answers 40
+bytes of floats, 20 bytes of integers, or nothing when there is no new value), and an error reply that the state
+byte alone marks (state != 0, no data)."""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+from conftest import examples, generate_and_import
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError
+
+shdlc = pytest.importorskip("sensirion_shdlc_driver.serial_frame_builder")
+Mosi = shdlc.ShdlcSerialMosiFrameBuilder
+Miso = shdlc.ShdlcSerialMisoFrameBuilder
+
+SPEC = Path(__file__).parent / "specs" / "shdlc_sps30.yaml"
+STUFFED = st.sampled_from([0x7E, 0x7D, 0x11, 0x13, 0x00, 0x20, 0xFF])  # the bytes that are escaped, and others
+U32 = st.one_of(
+    st.integers(0, 2**32 - 1),
+    st.lists(STUFFED, min_size=4, max_size=4).map(bytes).map(lambda b: int.from_bytes(b, "big")),
+)
+F32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
+
+
+@pytest.fixture(scope="module")
+def sp(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    return generate_and_import(SPEC, tmp_path_factory.mktemp("shdlc"), "shdlc_sps30")
+
+
+def miso_frame(address: int, command: int, state: int, data: bytes) -> bytes:
+    """A MISO frame made with the peer's own stuffing and checksum (it has no MISO builder)."""
+    content = bytearray([address, command, state, len(data)]) + data
+    content.append(Miso._calculate_checksum(content))
+    return b"\x7e" + bytes(Mosi._stuff_data_bytes(content)) + b"\x7e"
+
+
+def peer_reads(frame: bytes) -> tuple[int, int, int, bytes]:
+    builder = Miso()
+    assert builder.add_data(frame)
+    address, command, state, data = builder.interpret_data()
+    return address, command, state, bytes(data)
+
+
+@pytest.mark.parametrize(
+    ("command", "data", "name", "fields"),
+    [
+        (0x00, b"\x01\x03", "StartMeasurementRequest", {"output_format": 3}),
+        (0x00, b"\x01\x05", "StartMeasurementRequest", {"output_format": 5}),
+        (0x01, b"", "StopMeasurementRequest", {}),
+        (0x03, b"", "ReadMeasuredValuesRequest", {}),
+        (0x10, b"", "SleepRequest", {}),
+        (0x11, b"", "WakeUpRequest", {}),  # 7E 00 7D 31 00 EE 7E: the command 0x11 itself is escaped
+        (0x56, b"", "StartFanCleaningRequest", {}),
+        (0x80, b"\x00", "ReadAutoCleaningIntervalRequest", {}),  # its checksum 0x7E is sent as 7D 5E
+        (0xD0, b"\x03", "DeviceInformationRequest", {"what": 3}),
+        (0xD1, b"", "ReadVersionRequest", {}),
+        (0xD2, b"\x01", "ReadDeviceStatusRegisterRequest", {"clear": 1}),
+        (0xD3, b"", "DeviceResetRequest", {}),
+    ],
+)
+def test_requests_match_the_peers_mosi_frames(
+    sp: ModuleType, command: int, data: bytes, name: str, fields: dict[str, int]
+) -> None:
+    golden = Mosi(0, command, data).to_bytes()
+    message = getattr(sp, name)(address=0, **fields)
+    assert sp.encode(message) == golden
+    assert sp.decode(golden, sp.Direction.REQUEST) == message
+
+
+@settings(max_examples=examples(25), deadline=None)
+@given(address=STUFFED, interval=U32)
+def test_stuffed_interval_writes_match_the_peer(sp: ModuleType, address: int, interval: int) -> None:
+    golden = Mosi(address, 0x80, b"\x00" + struct.pack(">I", interval)).to_bytes()
+    message = sp.WriteAutoCleaningIntervalRequest(address=address, interval=interval)
+    assert sp.encode(message) == golden
+    assert sp.decode(golden, sp.Direction.REQUEST) == message
+
+
+@settings(max_examples=examples(25), deadline=None)
+@given(values=st.lists(F32, min_size=10, max_size=10), address=STUFFED)
+def test_measured_values_replies_are_read_by_the_peer(sp: ModuleType, values: list[float], address: int) -> None:
+    ok = sp.StateBits(error=0, code=0)
+    message = sp.ReadMeasuredValuesResponse(address, ok, *values)
+    frame = sp.encode(message)
+    got_address, command, state, data = peer_reads(frame)
+    assert (got_address, command, state) == (address, 0x03, 0)
+    assert struct.unpack(">10f", data) == tuple(values)
+    assert frame == miso_frame(address, 0x03, 0, data)
+    assert sp.decode(frame, sp.Direction.RESPONSE) == message
+
+
+@settings(max_examples=examples(15), deadline=None)
+@given(interval=U32, state=st.sampled_from([0, 0x80, 0x81]))
+def test_interval_replies_both_ways(sp: ModuleType, interval: int, state: int) -> None:
+    golden = miso_frame(0, 0x80, state, struct.pack(">I", interval))
+    message = sp.decode(golden, sp.Direction.RESPONSE)
+    assert message.interval == interval
+    assert (message.state.error, int(message.state.code)) == (state >> 7, state & 0x7F)
+    assert sp.encode(message) == golden
+    assert peer_reads(sp.encode(message))[3] == struct.pack(">I", interval)
+
+
+def test_device_information_and_version(sp: ModuleType) -> None:
+    """Product type "00080000" (a NUL-terminated string) and the version reply, both ways."""
+    golden = miso_frame(0, 0xD0, 0, b"00080000\x00")
+    ok = sp.StateBits(error=0, code=0)
+    assert sp.decode(golden, sp.Direction.RESPONSE) == sp.DeviceInformationResponse(0, ok, "00080000")
+    assert sp.encode(sp.DeviceInformationResponse(0, ok, "00080000")) == golden
+    version = miso_frame(0, 0xD1, 0, bytes([2, 2, 0, 7, 0, 2, 0]))
+    message = sp.decode(version, sp.Direction.RESPONSE)
+    assert (message.firmware_major, message.firmware_minor, message.hardware_revision) == (2, 2, 7)
+    assert sp.encode(message) == version
+
+
+def test_the_stream_parser_reads_stuffed_replies_in_pieces(sp: ModuleType) -> None:
+    frames = [miso_frame(0, 0x80, 0, b"\x00\x11\x7e\x13"), miso_frame(0, 0xD1, 0, bytes([2, 2, 0, 7, 0, 2, 0]))]
+    stream = b"\x7e\x7e\x00" + frames[0] + frames[0][:-3] + frames[1]  # a stray start, a frame cut short
+    parser = sp.StreamParser(sp.Direction.RESPONSE)
+    seen = [m for i in range(0, len(stream), 3) for m in parser.feed(stream[i : i + 3])]
+    assert [type(m).__name__ for m in seen] == ["ReadAutoCleaningIntervalResponse", "ReadVersionResponse"]
+    assert seen[0].interval == 0x00117E13
+
+
+def test_a_bad_checksum_is_refused(sp: ModuleType) -> None:
+    frame = bytearray(miso_frame(0, 0xD1, 0, bytes([2, 2, 0, 7, 0, 2, 0])))
+    frame[-2] ^= 0x01
+    with pytest.raises(DecodeError, match="checksum"):
+        sp.decode(bytes(frame), sp.Direction.RESPONSE)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="language gap: replies that share a code are told apart by the request they answer (`default: true` and "
+    "`expect`), never by their size, though a length element gives it (requests that share a code are told apart by "
+    "size). SPS30 Read Measured Values (0x03) answers 40 bytes (floats) or 20 (u16, after Start Measurement with "
+    "format 5) or 0 (no new values): each as a response-only command with `answers: read_measured_values` is refused "
+    "without a `default`, and with one a reply of another size does not decode without `expect`",
+)
+def test_read_measured_values_replies_by_size(tmp_path: Path) -> None:
+    from serialspec.cli import main
+
+    text = SPEC.read_text().replace(
+        "  sleep:\n    code: 0x10",
+        "  measured_values_u16:\n    code: 0x03\n    response:\n      answers: read_measured_values\n"
+        "      fields: {values: {type: array, of: u16, count: 10}}\n"
+        "  no_new_values:\n    code: 0x03\n    response:\n      answers: read_measured_values\n      fields: {}\n"
+        "  sleep:\n    code: 0x10",
+    )
+    spec = tmp_path / "sizes.yaml"
+    spec.write_text(text)
+    assert main(["decode", str(spec), miso_frame(0, 3, 0, b"").hex(), "--direction", "response"]) == 0
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="language gap: an SHDLC reply whose state byte is not 0 carries no data (7E 00 03 43 00 B9 7E: command "
+    "not allowed in this state); the language marks an error reply by a flag in the command code (`error_flag`) or "
+    "another header (`error_value`), not by a status element's value, so it is refused as too short",
+)
+def test_an_error_state_reply_without_data(sp: ModuleType) -> None:
+    message = sp.decode(miso_frame(0, 0x03, 0x43, b""), sp.Direction.RESPONSE)
+    assert int(message.state.code) == 0x43

@@ -673,7 +673,8 @@ COMMAND = Obj(
             "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
             "with a constant field of one width, no two equal: each is picked by that value before its size "
             "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
-            "its message is known). Frames without a command element share the same way.",
+            "its message is known), unless the requests sharing the code, picked by a constant, have one fixed size "
+            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,

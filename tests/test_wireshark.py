@@ -177,7 +177,7 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
     message = message_of(protocol, direction, command, subcommand)
     prefix = ".".join(p for p in (name, command, subcommand, direction) if p)
     fields: dict[str, Any] = {}
-    for element in protocol.framing.layouts[message.direction].value_elements:
+    for element in protocol.layout(message).value_elements:  # its own layout's (layouts chosen by command)
         if element.bits:
             item = child(tree, f"{name}.frame.{element.name}")
             fields[element.name] = {
@@ -189,7 +189,7 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
         refused = protocol.error_reply.element
         fields[refused] = int(child(tree, f"{prefix}.{refused}").get("show") or "")
     fields.update(fields_of(message.fields, tree, prefix))
-    for element in protocol.framing.layouts[message.direction].optional:  # its bytes where the frame has them
+    for element in protocol.layout(message).optional:  # its bytes where the frame has them
         sent = children(tree, f"{name}.frame.{element.name}")
         fields[element.name] = bytes.fromhex(sent[0].get("value") or "").hex(" ") if sent else None
     verdict = children(tree, f"{name}.checksum_ok")  # none where the frame has no checksum

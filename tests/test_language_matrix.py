@@ -1085,6 +1085,8 @@ CASES["bytes, text and a group sized by fields with a narrow range"] = same(
     }
 )
 # a value dividing by a field: frames with that field 0 have no value (refused everywhere, C too)
+# bytes of a fixed size with a default (a reserved run): messages and JSON may leave them out
+CASES["bytes: a default"] = same({"v": "u8", "reserved": {"type": "bytes", "size": 3, "default": "00 A5 00"}})
 CASES["value: an expression dividing by a field"] = same(
     {"d": {"type": "u8", "range": [1, 255], "default": 4}, "q": {"type": "u16", "value": "1000 / d"}, "r": "u8"}
 )

@@ -128,6 +128,12 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "t: {type: u16, encoding: seven_bit, const: 3}"), "`const` does not go with encoding seven"),
         # a number where an integer or text is wanted said "unexpected a number", and never why 1.0 is not an integer
         (("angle: i16", "t: {type: bytes, size: 2.0}"), "expected an integer or text, got a number (2.0):"),
+        # a default where a message could not use it was accepted and ignored; a bytes one is hex of its size
+        (("angle: i16", "t: {type: string, size: 4, default: 5}"), "`default` goes with a number or bytes of a fixed"),
+        (("angle: i16", "t: {type: bytes, size: 3, default: 00 00}"), "t.default: 2 bytes, the field's size is 3"),
+        (("angle: i16", "t: {type: bytes, size: rest, default: '00'}"), "goes with bytes of a fixed size (a number)"),
+        (("angle: i16", "t: {type: bytes, size: 2, default: 0}"), "expected hex text of 2 bytes ('00 00'), got 0"),
+        (("angle: i16", "t: {type: u8, default: '00'}"), "t.default: expected a number, got text ('00')"),
         (("angle: i16", "t: {type: u8, bits: {a: 1.0}}"), "expected an integer or a list or a mapping, got a number"),
         (
             ("angle: i16", "n: {type: u16, encoding: seven_bit}\n        v: {type: array, of: u8, count: n}"),

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "9de1afbbcc454d64d4f8aa374c23dc278e09a39ba65d9a4cf60e41505277ef5f"
+#define DYNAMIXEL_P2_SPEC_SHA256 "3b504b6ff1edd22f0e8a4d89e5d6c79ee60ca83b5ba6311e8dc02a059e4c5264"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "15eb75594d1457e6bb2d904692433c1a2d9af1b6067b63e5430844f9e5cb2f14"
+#define FEETECH_SMS_SPEC_SHA256 "0e2c2abc7c07d8d75203432d9767cc00c7788099445c5568793b6053d8b36985"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

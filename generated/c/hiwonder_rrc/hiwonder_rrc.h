@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "e5d361649b15d40dcc84528986e28760f4003a2e3d46e77af21fe6fef5dd2479"
+#define HIWONDER_RRC_SPEC_SHA256 "81399eb05369b74db6efccad3a598c95c93ea70a169d0bd85c479b983bff622f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

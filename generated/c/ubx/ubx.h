@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "ba423b508cf0f0599ee8f90e12dc5c0e81f25c8c9a0c3985a34685a53655e3ba"
+#define UBX_SPEC_SHA256 "ed276ce432cb312cf478be09c268a705c1eae0de602f4afc3ae2e8321a8aa1fb"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

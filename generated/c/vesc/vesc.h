@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "a0af0d424cf1b3457acf1ce3fed2444f2995686088f5e95a6b97eec5582db7bc"
+#define VESC_SPEC_SHA256 "1a312400544e75776d450b7df623d9106570a16191a918bb96129a07b698fe3e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

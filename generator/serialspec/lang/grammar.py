@@ -433,7 +433,11 @@ _FIELD_LONG: dict[str, Shape] = {
         "commands.NAME).",
         example=1,
     ),
-    "default": Num("Value used when a message is built without this field."),
+    "default": OneOf(
+        (Num(), Str()),
+        "Value used when a message is built without this field: a number; for bytes of a fixed size, their hex "
+        "(`reserved: {type: bytes, size: 3, default: 00 00 00}`).",
+    ),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),

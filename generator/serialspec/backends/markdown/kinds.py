@@ -157,6 +157,9 @@ class BytesKind(Kind[Bytes]):
         size = "rest of content" if f.size == "rest" else f.size
         return f"bytes ({size})"
 
+    def meaning(self, f: Bytes) -> list[str]:
+        return [f"Default `{f.default.hex(' ')}`."] if f.default is not None else []
+
 
 class GroupKind(Kind[Group]):
     model = Group

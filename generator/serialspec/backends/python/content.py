@@ -114,6 +114,8 @@ def preset_name(bits_class: str) -> str:
 def field_default(f: SpecField) -> str:
     """A field's default as Python source ("" for none): a plain number's `default`, or its bits class built with
     every bit field's constant or default where each has one."""
+    if isinstance(f, Bytes):
+        return repr(f.default) if f.default is not None else ""
     if not isinstance(f, Scalar):
         return ""
     if f.bits:

@@ -349,9 +349,13 @@ class BytesKind(Kind[Bytes]):
 
     def from_json(self, f: Bytes) -> Calls:
         get = _get(f)
+        if f.default is not None:  # left out: its default, as the message class has it
+            get = Calls(f"data.get({spec_key(f.name)}, {f.default.hex(' ')!r})", [])
         return Calls(f"_bytes({get}, {spec_key(f.name)}, where)", ["_bytes"], get)
 
     def blank(self, f: Bytes) -> str:
+        if f.default is not None:
+            return repr(f.default.hex(" "))
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
 
 

@@ -27,6 +27,7 @@ from serialspec.lang.model import (
     sum_sizes,
 )
 from serialspec.lang.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
+from serialspec.runtime.hexbytes import parse_hex
 
 FIELD_KINDS = (
     *grammar.FIELD_SCALAR_TYPES,
@@ -220,6 +221,8 @@ class FieldResolver(Pass):
         if encoding != "plain" and not text_encoding:
             what = "a string takes only seven_bit (14-bit characters)" if kind == "string" else f"a {kind} has none"
             self.error((*path, "encoding"), f"`encoding` is how an integer is stored: {what}")
+        if "default" in spec and kind != "bytes":
+            self.error((*path, "default"), f"`default` goes with a number or bytes of a fixed size, not a {kind}")
         if kind == "bytes":
             size = spec.get("size")
             if size is None:
@@ -241,8 +244,10 @@ class FieldResolver(Pass):
                     raise self.fail(
                         (*path, "start"), f"unknown field {start!r}: `start` names an earlier integer field"
                     )
+            default = self.bytes_default(spec.get("default"), size, (*path, "default"))
             return Bytes(
                 **common,
+                default=default,
                 size=size,
                 table=table,
                 start=start.removeprefix("request."),
@@ -424,6 +429,26 @@ class FieldResolver(Pass):
         except expression.ExpressionError as exc:
             raise self.fail(path, str(exc)) from None
 
+    def bytes_default(self, given: Any, size: int | str, path: Path) -> bytes | None:
+        """A bytes field's `default`: hex text of exactly its fixed size."""
+        if given is None:
+            return None
+        if not isinstance(size, int):
+            self.error(path, f"`default` goes with bytes of a fixed size (a number), not size {size}")
+            return None
+        if not isinstance(given, str):
+            self.error(path, f"expected hex text of {size} bytes ('{' '.join(['00'] * min(size, 4))}'), got {given!r}")
+            return None
+        try:
+            value = parse_hex(given)
+        except ValueError as exc:
+            self.error(path, str(exc))
+            return None
+        if len(value) != size:
+            self.error(path, f"{len(value)} bytes, the field's size is {size}")
+            return None
+        return value
+
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         scalar = self.stored(field_type(spec["type"]), sign_magnitude, (*path, "encoding"))
@@ -447,6 +472,8 @@ class FieldResolver(Pass):
         if "offset" in spec and any(k in spec for k in ("enum", "flags", "bits")):
             self.error((*path, "offset"), "`offset` goes with a number, not an enum, flags or bit fields")
         default = spec.get("default")
+        if isinstance(default, str):
+            raise self.fail((*path, "default"), f"expected a number, got text ({default!r})")
         if default is not None and not low <= default <= high:
             self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
         bits: list[BitField] = []

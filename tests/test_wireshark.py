@@ -177,7 +177,7 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
     message = message_of(protocol, direction, command, subcommand)
     prefix = ".".join(p for p in (name, command, subcommand, direction) if p)
     fields: dict[str, Any] = {}
-    for element in protocol.framing.layouts[message.direction].value_elements:
+    for element in protocol.layout(message).value_elements:  # its own layout's (layouts chosen by command)
         if element.bits:
             item = child(tree, f"{name}.frame.{element.name}")
             fields[element.name] = {

@@ -4,12 +4,13 @@ none of which imports it."""
 
 from __future__ import annotations
 
-from serialspec.backends.c import text
+from serialspec.backends.c import length_byte, text
 from serialspec.backends.c.emit import Ctx, refuse_unsupported
 from serialspec.backends.c.files import header, json_header, json_source, source
 from serialspec.backends.c.optional import expanded
 from serialspec.backends.c.readme import readme
 from serialspec.backends.c.vectors import check_vectors, vectors_header
+from serialspec.backends.common.frames import refuse_code_forms
 from serialspec.lang.model import Protocol
 
 
@@ -17,6 +18,7 @@ def files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:  # a text protocol: backends/c/text.py
         return text.files(protocol, protocol.text)
     refuse_unsupported(protocol)
+    refuse_code_forms(protocol, length_byte.applies(protocol))  # (emit.py: length_byte imports it)
 
     spec = protocol
     protocol, variants = expanded(spec)  # optional elements: each layout's plain variants in its place

@@ -18,7 +18,6 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
-from serialspec.backends.common.frames import refuse_code_forms
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
 from serialspec.encodings import bit_run, seven_bit
@@ -218,9 +217,6 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
     refuse_by_request(protocol)
-    from serialspec.backends.c import length_byte  # (which imports this module)
-
-    refuse_code_forms(protocol, length_byte.applies(protocol))
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

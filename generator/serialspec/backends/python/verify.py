@@ -1,8 +1,9 @@
-"""Run a spec's examples and errata through the package just generated from it, before anything is written.
+"""Run a spec's examples and errata through the package just generated from it (in memory).
 
 `generate` and `check` report an example that does not decode to its recorded values (or whose values do not encode
 back to its bytes), and an erratum whose check does not hold, as spec errors at the example's or check's line.
-The package is imported from the generated text in memory (serialspec.backends.python.memory).
+The package is imported from the generated text in memory (serialspec.backends.python.memory). `generate` still
+writes the files and exits 1, so that the package can show what a failing example's frame holds.
 """
 
 from __future__ import annotations

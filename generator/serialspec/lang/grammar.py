@@ -487,7 +487,12 @@ _FIELD_LONG: dict[str, Shape] = {
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
-    "size_from": Str("bytes of a response, size `rest`: the request field giving its size (request.<field>)."),
+    "size_from": Str(
+        "bytes of a response, size `rest`: the request field giving its size (request.<field>). Where the frame "
+        "carries no length (a raw read: the Pololu Tic's Get Variable answers `length` bytes alone), the stream "
+        "parser sizes the reply awaited by that field of its request (the client's), and decode with the request "
+        "refuses a reply of another size."
+    ),
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
     "inferred": TEXT,

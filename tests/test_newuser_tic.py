@@ -22,6 +22,7 @@ from serialspec.lang import load_protocol
 from serialspec.lang.errors import SpecErrors
 from serialspec.runtime.errors import DecodeError, RangeError
 from sim_process import serve
+from test_newuser_maestro import POLOLU_FORM as MAESTRO_FORMS
 
 ticlib = pytest.importorskip("ticlib")
 
@@ -134,14 +135,8 @@ def test_a_32_bit_target_as_one_field(tmp_path: Path) -> None:
     assert module.encode(module.SetTargetPositionRequest(target=-100)) == written("set_target_position", -100)
 
 
-POLOLU_FORM = """
-    pololu:
-      elements:
-        start: {role: header, value: AA, directions: [request]}
-        device: {role: address, type: u8, range: [0, 127], directions: [request]}
-        command: {role: command, type: u8, directions: [request], code: "code & 0x7F"}
-        content: {role: content}
-"""
+# the Maestro's Pololu protocol layout, the same for the Tic
+POLOLU_FORM = MAESTRO_FORMS[MAESTRO_FORMS.index("    pololu:") : MAESTRO_FORMS.index("commands:")]
 
 
 @pytest.mark.xfail(

@@ -18,6 +18,8 @@ import pytest
 from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from serialspec.backends import Unsupported
+from serialspec.backends.c.build import files as c_files
 from serialspec.lang import load_protocol
 from serialspec.lang.errors import SpecErrors
 from serialspec.runtime.errors import DecodeError, RangeError
@@ -164,7 +166,7 @@ def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:
     """A bug fixed: a reply of `size: rest` bytes, `size_from: request.length`, in a layout with no length, was
     never taken by the stream parser (nothing sized it: the client timed out on every Get Variable), and decode
     took any number of bytes. The reply awaited is now sized by its request's field, and decode refuses a reply
-    of another size in one line."""
+    of another size in one line; the C target, whose parser cannot size it yet, says so."""
     request = tic.GetVariableRequest(offset=0x22, length=4)
     parser = tic.StreamParser(tic.Direction.RESPONSE)
     parser.expect(tic.GetVariableResponse, request)
@@ -174,3 +176,5 @@ def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:
     assert parser.feed(bytes.fromhex("0a")) == [tic.GetVariableResponse(data=b"\x0a")]
     with pytest.raises(DecodeError, match="3 content bytes, where the request's length = 4 asks for 4"):
         tic.decode(bytes.fromhex("79 29 ed"), tic.Direction.RESPONSE, None, request)
+    with pytest.raises(Unsupported, match=r"a reply sized by a field of its request in a frame without a length"):
+        c_files(load_protocol(SPEC))  # the C parser cannot size it yet: no C rather than C that never takes it

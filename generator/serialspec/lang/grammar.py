@@ -224,7 +224,16 @@ class Obj(Shape):
                 yield path, f"missing key {key!r}"
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
-            if shape is None:
+            if shape is None and isinstance(key, str) and " " in key.strip() and item is None:
+                # `{description: Low byte, bit 7 cleared.}`: YAML ends the value at the comma, the rest is a key
+                yield (
+                    (*path, key),
+                    (
+                        f"unknown key {key!r}: a comma inside {{...}} ends a value, so the text after it became a key "
+                        '(quote text that holds a comma: description: "..., ...")'
+                    ),
+                )
+            elif shape is None:
                 yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)})"
             else:
                 yield from shape.check(item, (*path, key))

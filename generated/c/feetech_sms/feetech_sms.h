@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "15eb75594d1457e6bb2d904692433c1a2d9af1b6067b63e5430844f9e5cb2f14"
+#define FEETECH_SMS_SPEC_SHA256 "7e347d20e5c71c2aa5ab14972405f57a67d19153b99e86798e90a9f94a96caf3"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -423,7 +423,10 @@ _FIELD_LONG: dict[str, Shape] = {
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
-    "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "scale": Num(
+        "Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps); a number field's (an array refuses it: its "
+        "items are shown as sent, with the `unit` of one step)."
+    ),
     "offset": Num(
         "Added after `scale`: engineering value = wire value × scale + offset (CRSF GPS altitude: wire metres "
         "+ 1000, so offset -1000). `range` stays in wire units.",

@@ -22,7 +22,7 @@ from serialspec.backends import Unsupported
 from serialspec.backends.c.build import files as c_files
 from serialspec.lang import load_protocol
 from serialspec.lang.errors import SpecErrors
-from serialspec.runtime.errors import DecodeError, RangeError
+from serialspec.runtime.errors import DecodeError, EncodeError, RangeError
 from sim_process import serve
 from test_newuser_maestro import POLOLU_FORM as MAESTRO_FORMS
 
@@ -165,8 +165,8 @@ def test_the_pololu_protocol_form(tmp_path: Path) -> None:
 def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:
     """A bug fixed: a reply of `size: rest` bytes, `size_from: request.length`, in a layout with no length, was
     never taken by the stream parser (nothing sized it: the client timed out on every Get Variable), and decode
-    took any number of bytes. The reply awaited is now sized by its request's field, and decode refuses a reply
-    of another size in one line; the C target, whose parser cannot size it yet, says so."""
+    took any number of bytes. The reply awaited is now sized by its request's field, and decode (encode, given the
+    request) refuses a reply of another size in one line; the C target, whose parser cannot size it yet, says so."""
     request = tic.GetVariableRequest(offset=0x22, length=4)
     parser = tic.StreamParser(tic.Direction.RESPONSE)
     parser.expect(tic.GetVariableResponse, request)
@@ -174,7 +174,9 @@ def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:
     assert parser.feed(bytes.fromhex("ed ff")) == [tic.GetVariableResponse(data=bytes.fromhex("79 29 ed ff"))]
     parser.expect(tic.GetVariableResponse, tic.GetVariableRequest(offset=0, length=1))
     assert parser.feed(bytes.fromhex("0a")) == [tic.GetVariableResponse(data=b"\x0a")]
-    with pytest.raises(DecodeError, match="3 content bytes, where the request's length = 4 asks for 4"):
+    with pytest.raises(DecodeError, match=r"3 content bytes, where its request asks for 4 \(length = 4\)"):
         tic.decode(bytes.fromhex("79 29 ed"), tic.Direction.RESPONSE, None, request)
+    with pytest.raises(EncodeError, match=r"2 content bytes, where its request asks for 4 \(length = 4\)"):
+        tic.encode(tic.GetVariableResponse(data=b"\x79\x29"), request)
     with pytest.raises(Unsupported, match=r"a reply sized by a field of its request in a frame without a length"):
         c_files(load_protocol(SPEC))  # the C parser cannot size it yet: no C rather than C that never takes it

@@ -502,8 +502,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "size_from": Str(
         "bytes of a response, size `rest`: the request field giving its size (request.<field>). Where the frame "
         "carries no length (a raw read: the Pololu Tic's Get Variable answers `length` bytes alone), the stream "
-        "parser sizes the reply awaited by that field of its request (the client's), and decode with the request "
-        "refuses a reply of another size (the C target, not yet)."
+        "parser sizes the reply awaited by that field of its request (the client's), and decode and encode with the "
+        "request refuse a reply of another size (the simulator then answers nothing and logs why; the C target "
+        "refuses such a spec, not yet)."
     ),
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),

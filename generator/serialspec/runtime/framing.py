@@ -730,17 +730,18 @@ class FrameCodec:
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
 
-    def asked(self, expect: Any, content: bytes, request: Any) -> None:
+    def asked(self, expect: Any, content: bytes, request: Any, error: type[Exception] = DecodeError) -> None:
         """A reply whose last bytes are as many as a field of its request says (a SizeRule with `request`): refused
-        when the frame holds another number of them (a reply cut short, or one to another request)."""
+        (`error`: DecodeError, or EncodeError on encode) when it holds another number of them (a reply cut short,
+        or one to another request)."""
         rule = self.size_rules.get(_class_name(expect))
         if rule is None or not rule.request or request is None:
             return
         wanted = rule.size(b"", 0, 0, request)
         if wanted is not None and wanted != len(content):
-            raise DecodeError(
-                f"{_class_name(expect)}: {len(content)} content bytes, where the request's {rule.request} = "
-                f"{getattr(request, rule.request)} asks for {wanted}"
+            raise error(
+                f"{_class_name(expect)}: {len(content)} content bytes, where its request asks for {wanted} "
+                f"({rule.request} = {getattr(request, rule.request)})"
             )
 
     def unwrap(self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None) -> Unwrapped:

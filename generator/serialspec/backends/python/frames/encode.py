@@ -46,6 +46,7 @@ from serialspec.backends.python.kinds import (
 )
 from serialspec.backends.python.optimize import field_read
 from serialspec.lang.model import (
+    Bytes,
     Direction,
     FrameLayout,
     Message,
@@ -489,6 +490,8 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             return body
         if framing.requesting:  # its layout, and the request a reply answers
             arguments += f", {layout_index(package.protocol, message)}, request"
+            if asked_size(message):  # as many last bytes as the request asks for: refused otherwise
+                body.append(Code(f"_RESPONSE_FRAMES.asked({message.class_name}, {content}, request, EncodeError)"))
         arguments += extras
         body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
         return body
@@ -610,3 +613,10 @@ def length_byte_lines(
     body.append(Code(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content"))
     body.extend(checksum_append(package, layout, "body"))
     return body
+
+
+def asked_size(message: Message) -> bool:
+    """A reply whose last bytes are as many as a field of its request says (`size_from`), in frames without a
+    length (the runtime's SizeRule with `request`)."""
+    last = message.fields[-1] if message.fields else None
+    return message.direction == Direction.RESPONSE and isinstance(last, Bytes) and bool(last.size_from)

@@ -680,7 +680,9 @@ COMMAND = Obj(
             "commands may share a code when no content size fits two of them: each is its own message, "
             "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
             "with a constant field of one width, no two equal: each is picked by that value before its size "
-            "(below, RTCM 3's message number). Frames without a command element share the same way.",
+            "(below, RTCM 3's message number). Frames without a command element share the same way. Either needs "
+            "a length element in the frame (without one, requests that share a code are refused), and only "
+            "requests are picked so (replies that share a code are chosen by the request they answer).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -770,7 +772,9 @@ COMMAND = Obj(
             "`descriptor` of 5 bytes (antenna `A`) is a descriptor, though a `station` is 5 bytes too. A value no "
             "message has is refused in one line (`unknown message_number 1004`). Where some message has no such "
             "field, or widths or values clash, the messages are told apart by their content size alone, which no "
-            "two may share. The reference says of each message that it is chosen by its constant.",
+            "two may share. The reference says of each message that it is chosen by its constant. The frame needs a "
+            "length element (RTCM 3's 10-bit length): a frame without one, whose size would follow from the "
+            "message picked (Kondo ICS's command in the top bits of its first byte), is refused for now.",
         ),
     ),
 )

@@ -180,3 +180,16 @@ def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:
         tic.encode(tic.GetVariableResponse(data=b"\x79\x29"), request)
     with pytest.raises(Unsupported, match=r"a reply sized by a field of its request in a frame without a length"):
         c_files(load_protocol(SPEC))  # the C parser cannot size it yet: no C rather than C that never takes it
+
+
+def test_an_examples_bytes_may_be_written_in_any_hex_form() -> None:
+    """Found writing this spec: `fields: {data: 7929edff}` in an example was refused (`data is '79 29 ed ff', not
+    '7929edff'`), though `frame:` and `printed:` take any hex form people write; recorded values are now compared as
+    the message's JSON writes them."""
+    from serialspec.backends.python.package import emit_package
+    from serialspec.backends.python.verify import verify
+
+    protocol = load_protocol(SPEC)
+    [example] = [e for e in protocol.examples if e.name == "position_reply"]
+    assert example.fields == {"data": "7929edff"}
+    assert verify(protocol, emit_package(protocol)) == []

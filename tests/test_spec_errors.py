@@ -139,6 +139,13 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
             ("angle: i16", "n: {type: u16, encoding: seven_bit}\n        v: {type: array, of: u8, count: n}"),
             "'n' holds a count or size: plain, not encoding seven_bit",
         ),
+        # found by new users (tests/test_newuser_*.py): a comma in a flow mapping's text made the rest a key, and
+        # a scale on an array was dropped without a word
+        (
+            ("angle: i16", "angle: {type: i16, description: The angle, in steps.}"),
+            "a comma inside `{...}` ends a value: quote text that holds one",
+        ),
+        (("angle: i16", "rc: {type: array, of: u16, count: 2, scale: 0.125}"), "`scale` goes with a number field"),
     ],
 )
 def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[str, str], expected: str) -> None:

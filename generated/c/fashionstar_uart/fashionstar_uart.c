@@ -40,7 +40,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__OPTIONALS 0u /* the most optional elements a direction has */
 
 /* ---- checksums ---- */
-/* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
+/* Sum of the bytes modulo 2^8. Incremental: start with 0 (or `init`); the frame's checksum is the sum. */
 uint8_t fashionstar_uart_sum8(uint8_t acc, const uint8_t *data, size_t n)
 {
     uint32_t s = acc;

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "0e2c2abc7c07d8d75203432d9767cc00c7788099445c5568793b6053d8b36985"
+#define FEETECH_SMS_SPEC_SHA256 "830563caa75cb1c18073bc8cf352aad900c31626434f5aa435058f5c0bd8df79"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -676,7 +676,7 @@ proto.experts = {e_checksum, e_malformed, e_garbage, e_request}
 local CHECKSUMS = {}
 CHECKSUMS["sum"] = function(spec, size, data)
   local mask = width_mask(size * 8)
-  local total = 0
+  local total = spec.init or 0
   for i = 1, #data do
     total = total + data:byte(i)
     if spec.end_around_carry then

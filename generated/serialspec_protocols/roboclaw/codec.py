@@ -929,6 +929,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None, request:
         expect = _REPLY_TO.get(type(request))
     unwrapped = _RESPONSE_FRAMES.unwrap(frame, expect, _request_parts(request))
     code, content = unwrapped.code, unwrapped.content
+    _RESPONSE_FRAMES.asked(expect, content, request)
     try:
         decoder = _RESPONSE_DECODERS[code]
     except KeyError:

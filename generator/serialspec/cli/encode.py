@@ -27,6 +27,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def only_direction(package: Any, data: dict[str, Any]) -> str:
+    """The direction a command goes in when the object names none: its only one (a receiver's unsolicited frame is
+    a response), else a request."""
+    found = {
+        cls.DIRECTION.value
+        for cls in getattr(package, "MESSAGE_TYPES", ())
+        if (data["command"], data.get("subcommand")) == (cls.COMMAND, cls.SUBCOMMAND)
+    }
+    return found.pop() if len(found) == 1 else "request"
+
+
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     try:
@@ -37,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
         raise EncodeError(f"--json cannot be read: {str(exc).split(';')[0]}") from None
     if not isinstance(data, dict) or "command" not in data:
         raise EncodeError("--json must be an object with at least `command` and `fields`")
-    direction = args.direction or data.get("direction") or "request"
+    direction = args.direction or data.get("direction") or only_direction(package, data)
     if direction not in ("request", "response"):
         raise EncodeError(f"`direction` must be 'request' or 'response', got {direction!r}")
     if protocol.text is not None:

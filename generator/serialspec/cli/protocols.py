@@ -233,9 +233,17 @@ def message_type(package: ModuleType, command: str, subcommand: str | None, dire
         }
     )
     close = difflib.get_close_matches(what, names, n=3)
+    other = "response" if direction == "request" else "request"
+    elsewhere = any(
+        (c.COMMAND, c.SUBCOMMAND, c.DIRECTION.value) == (command, subcommand, other) for c in package.MESSAGE_TYPES
+    )
     hint = (
-        f" (did you mean {' or '.join(close)}?)"
+        f" (it is a {other}: give the direction {other})"
+        if elsewhere
+        else f" (did you mean {' or '.join(close)}?)"
         if close
+        else f" (it has no {direction}s)"
+        if not names
         else f" (it has {', '.join(names)})"
         if len(names) <= 12
         else ""

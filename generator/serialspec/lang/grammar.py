@@ -420,7 +420,10 @@ _FIELD_LONG: dict[str, Shape] = {
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
-    "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "scale": Num(
+        "Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps); a number field's (an array refuses it: its "
+        "items are shown as sent, with the `unit` of one step)."
+    ),
     "offset": Num(
         "Added after `scale`: engineering value = wire value × scale + offset (CRSF GPS altitude: wire metres "
         "+ 1000, so offset -1000). `range` stays in wire units.",
@@ -497,7 +500,13 @@ _FIELD_LONG: dict[str, Shape] = {
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
-    "size_from": Str("bytes of a response, size `rest`: the request field giving its size (request.<field>)."),
+    "size_from": Str(
+        "bytes of a response, size `rest`: the request field giving its size (request.<field>). Where the frame "
+        "carries no length (a raw read: the Pololu Tic's Get Variable answers `length` bytes alone), the stream "
+        "parser sizes the reply awaited by that field of its request (the client's), and decode and encode with the "
+        "request refuse a reply of another size (the simulator then answers nothing and logs why; the C target "
+        "refuses such a spec, not yet)."
+    ),
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
     "inferred": TEXT,
@@ -678,7 +687,8 @@ COMMAND = Obj(
             "with a constant field of one width, no two equal: each is picked by that value before its size "
             "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
             "its message is known), unless the requests sharing the code, picked by a constant, have one fixed size "
-            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way.",
+            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way. Only "
+            "requests are picked so (replies that share a code are chosen by the request they answer).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -774,7 +784,8 @@ COMMAND = Obj(
             "two may share. The reference says of each message that it is chosen by its constant. In a frame "
             "without a length element, the requests that share a code need one fixed content size, which sizes "
             "their frames (iRobot's Open Interface: `8E 16` asks for the voltage, `8E 17` the current, both "
-            "`code: 0x8E` with `packet_id: {type: u8, const: 22}` or `23`).",
+            "`code: 0x8E` with `packet_id: {type: u8, const: 22}` or `23`); such messages of different sizes "
+            "(Kondo ICS's command in the top bits of its first byte) are refused for now.",
         ),
     ),
 )

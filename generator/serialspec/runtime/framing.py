@@ -620,8 +620,14 @@ class SizeRule:
     fixed: int
     terms: tuple[tuple[int, int, Literal["little", "big"], int], ...] = ()  # (offset, size, endian, factor)
     nul: int = -1  # the offset of a NUL-terminated text that ends the content: sized by its NUL (fixed: before it)
+    # a reply's last bytes as many as a field of the request it answers says (`size_from: request.length`: the Tic's
+    # and the Maestro's raw reads): the size needs that request, and with none there is no such reply
+    request: str = ""
 
-    def size(self, buffer: bytes, start: int, end: int) -> int | None:
+    def size(self, buffer: bytes, start: int, end: int, asked: Any = None) -> int | None:
+        if self.request:
+            wanted = getattr(asked, self.request, None)
+            return self.fixed + wanted if isinstance(wanted, int) else -1
         if self.nul >= 0:
             found = buffer.find(0, start + self.nul, end)
             return None if found < 0 else found + 1 - start
@@ -730,6 +736,20 @@ class FrameCodec:
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
 
+    def asked(self, expect: Any, content: bytes, request: Any, error: type[Exception] = DecodeError) -> None:
+        """A reply whose last bytes are as many as a field of its request says (a SizeRule with `request`): refused
+        (`error`: DecodeError, or EncodeError on encode) when it holds another number of them (a reply cut short,
+        or one to another request)."""
+        rule = self.size_rules.get(_class_name(expect))
+        if rule is None or not rule.request or request is None:
+            return
+        wanted = rule.size(b"", 0, 0, request)
+        if wanted is not None and wanted != len(content):
+            raise error(
+                f"{_class_name(expect)}: {len(content)} content bytes, where its request asks for {wanted} "
+                f"({rule.request} = {getattr(request, rule.request)})"
+            )
+
     def unwrap(self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None) -> Unwrapped:
         """Check a frame and take it apart: in the layout its header names, in the layout of its code (layouts
         chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class)."""
@@ -777,9 +797,12 @@ class FrameCodec:
             raise problem
         return self.layout_of(frame).unwrap(frame, request)
 
-    def probe(self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None) -> int | None:
+    def probe(
+        self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None, asked: Any = None
+    ) -> int | None:
         """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none.
-        `expect`: the reply class awaited, for replies read in the layout of their request (`replies`)."""
+        `expect`: the reply class awaited, for replies read in the layout of their request (`replies`); `asked`:
+        the request it answers (a reply sized by a request field)."""
         reading = self._reading(layout, expect) if self.replies else None
         if self.replies and reading is None:
             return -1  # no reply awaited, or one of another layout
@@ -835,7 +858,7 @@ class FrameCodec:
         rule = self.size_rules.get(code)
         if rule is None:
             return _terminated(layout, buffer, start, end, low, high) if layout.trailer else -1
-        content_size = rule.size(buffer, start + plan["prefix"], end)
+        content_size = rule.size(buffer, start + plan["prefix"], end, asked)
         if content_size is None:
             return None
         if content_size < low or (high is not None and content_size > high):
@@ -1115,7 +1138,7 @@ class FrameStreamParser(StreamParser):
 
     def _by_request(self, codec: FrameCodec, layout: Layout) -> Callable[[bytes, int, int], int | None]:
         """The sizer of a layout of replies read in the layout of their request: the awaited reply class's."""
-        return lambda buffer, start, end: codec.probe(layout, buffer, start, end, self.expected)
+        return lambda buffer, start, end: codec.probe(layout, buffer, start, end, self.expected, self.request)
 
     def expect(self, cls: type[Message] | None, request: Message | None = None) -> None:
         """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's),

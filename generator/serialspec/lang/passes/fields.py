@@ -272,6 +272,10 @@ class FieldResolver(Pass):
                 self.error((*path, "encoding"), why)
             pad = self.pad(spec.get("pad"), size, (*path, "pad"))
             return Text(**common, size=size, pad=pad, seven_bit=text_encoding)
+        if kind == "array" and (odd := [key for key in ("scale", "offset") if key in spec]):
+            self.error(  # an array's items are kept, shown and plotted as sent: a scale would be silently lost
+                (*path, odd[0]), f"`{odd[0]}` goes with a number field, not an array (give the unit of one wire step)"
+            )
         if kind == "array" and _PACKED.match(str(spec.get("of", ""))) and str(spec["of"]) not in _BYTE_ALIGNED:
             return self.packed(common, spec, path, endian)
         if "bit_order" in spec:

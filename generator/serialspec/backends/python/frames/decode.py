@@ -302,6 +302,7 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target, suffix: str = "") 
             ),
             f"    unwrapped = {frames}.unwrap(frame, expect, _request_parts(request))",
             "    code, content = unwrapped.code, unwrapped.content",
+            *([f"    {frames}.asked(expect, content, request)"] if direction == "response" else []),
         ]
         return _engine_decode(decode, target), wrap
     wrap = [

@@ -47,6 +47,7 @@ from serialspec.backends.python.kinds import (
 )
 from serialspec.backends.python.optimize import field_read
 from serialspec.lang.model import (
+    Bytes,
     Direction,
     FrameLayout,
     Message,
@@ -490,6 +491,8 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
             return body
         if framing.requesting:  # its layout, and the request a reply answers
             index = layout_index(package.protocol, message)
+            if asked_size(message):  # as many last bytes as the request asks for: refused otherwise
+                body.append(Code(f"_RESPONSE_FRAMES.asked({message.class_name}, {content}, request, EncodeError)"))
             first = framing.layouts[message.direction]
             if [e.name for e in layout.value_elements] != [e.name for e in first.value_elements]:
                 # layouts chosen by command with values of their own: the engine takes this layout's
@@ -619,3 +622,10 @@ def length_byte_lines(
     body.append(Code(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content"))
     body.extend(checksum_append(package, layout, "body"))
     return body
+
+
+def asked_size(message: Message) -> bool:
+    """A reply whose last bytes are as many as a field of its request says (`size_from`), in frames without a
+    length (the runtime's SizeRule with `request`)."""
+    last = message.fields[-1] if message.fields else None
+    return message.direction == Direction.RESPONSE and isinstance(last, Bytes) and bool(last.size_from)

@@ -17,14 +17,17 @@ from serialspec.backends.python.checksum_code import checksum_name
 from serialspec.backends.python.dispatch import ERROR_REPLY
 from serialspec.checksums.base import Import
 from serialspec.lang.model import (
+    Bytes,
     Direction,
     FrameElement,
     FrameLayout,
     Message,
     Protocol,
+    fixed_size,
     nul_ended,
     size_terms,
 )
+from serialspec.lang.names import python_name
 from serialspec.transforms import runtime_classes
 
 # runtime.framing's classes (each transform's runtime class among them), in the order isort wants
@@ -126,6 +129,10 @@ def size_rule(message: Message) -> str | None:
     """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
     found = size_terms(message.fields)
     text = nul_ended(message.fields)
+    *before, last = message.fields or (None,)
+    if isinstance(last, Bytes) and last.size_from and all(fixed_size(f) is not None for f in before):
+        # a reply's last bytes, as many as the request's field says (`size_from`): sized with that request
+        return f"SizeRule({sum(fixed_size(f) or 0 for f in before)}, request={python_name(last.size_from)!r})"
     if found is None and text is not None:
         return f"SizeRule({text}, nul={text})"
     if found is None:

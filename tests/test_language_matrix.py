@@ -37,7 +37,7 @@ from serialspec.backends.python.memory import imported
 from serialspec.encodings import bit_run
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Direction, Message, Protocol, replies_by_request, reply_to
+from serialspec.lang.model import Direction, Message, Protocol, leading_constant, replies_by_request, reply_to
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.errors import DecodeError
@@ -851,6 +851,32 @@ CASES["requests picked by a leading constant bit field, no command element"] = C
         },
     },
 )
+# Messages picked by their leading constant in a frame with no command element and no length, each of its own size
+# (Kondo ICS: the command in a byte's top 3 bits, the servo id in its low 5; MIDI: a u4 status before a u4 channel
+# beside u8 system messages, a prefix code): requests and replies alike, each sized by its own bytes (fixed, or a
+# count before the rest)
+CASES["messages picked by leading constants of mixed widths, no command element, no length"] = Case(
+    {"kind": {"type": "u3", "const": 4}, "id": "u5", "position": {"type": "u16", "encoding": "seven_bit"}},
+    {"kind": {"type": "u3", "const": 0}, "id": "u5", "position": {"type": "u16", "encoding": "seven_bit"}},
+    {"elements": {"content": {"role": "content"}}},
+    commands={
+        "read": {
+            "request": {"fields": {"kind": {"type": "u3", "const": 5}, "id": "u5", "what": "u8"}},
+            "response": {"fields": {"kind": {"type": "u3", "const": 1}, "id": "u5", "what": "u8", "v": "u8"}},
+        },
+        "dump": {
+            "request": {
+                "fields": {
+                    "kind": {"type": "u3", "const": 6},
+                    "id": "u5",
+                    "n": {"type": "u8", "range": [0, 6]},
+                    "data": {"type": "bytes", "size": "n"},
+                }
+            }
+        },
+        "stop": {"request": {"fields": {"kind": {"type": "u8", "const": 0xFF}}}},
+    },
+)
 # The device rules and unsolicited output: the simulator sends `beat` every 5 ms while the client's requests are
 # matched to their replies (client_against_simulator), a derived entry, a lock, a move to an expression.
 CASES["device: derived, locks, sends, moves.to"] = Case(
@@ -1416,6 +1442,13 @@ def stream_direction(g: Generated, direction: str) -> None:
             if e.role == "address"
             for v in range(int(e.minimum), int(e.maximum) + 1)
         }
+    if any(layout.elements[0].role == "content" for layout in g.protocol.framing.alternatives[Direction(direction)]):
+        # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
+        for message in g.protocol.messages():
+            found = leading_constant(message)
+            if found is not None and found[0][0] == 1:
+                (_, _, shift, bits), value = found
+                headers |= {b for b in range(256) if b >> shift & ((1 << bits) - 1) == value}
     garbage = st.binary(max_size=6).map(lambda b: bytes(x for x in b if x not in headers))
     messages = [m for m in g.protocol.messages() if m.direction.value == direction]
     if g.protocol.framing.by_request(Direction(direction)):

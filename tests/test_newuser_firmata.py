@@ -212,7 +212,11 @@ def test_bits_on_a_command_element_are_refused(tmp_path: Path) -> None:
     accepted and ignored, so `e3 7f 07` was an unknown command; now the spec is refused in one line at its place."""
     path = tmp_path / "channel.yaml"
     path.write_text(CHANNEL.replace("PIN", "bits: {kind: {bits: [7, 4]}, pin: {bits: [3, 0]}}"), "utf-8")
-    with pytest.raises(SpecErrors, match=r"command\.bits: `bits` belongs to an address, status or value element"):
+    with pytest.raises(
+        SpecErrors,
+        match=r"command\.bits: `bits` belongs to an address, status or value element.*"
+        r"leave out the command element and begin each message with its code as a constant bit field",
+    ):
         load_protocol(str(path))
 
 
@@ -232,20 +236,42 @@ commands:
 """
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: a channel number in the low bits of the command byte (MIDI channel messages: Firmata's "
-    "DIGITAL_MESSAGE 0x90 | port, ANALOG_MESSAGE 0xE0 | pin, REPORT_ANALOG 0xC0 | pin, REPORT_DIGITAL 0xD0 | port). "
-    "The command element has no way to say that only its high bits are the code and its low bits a value the "
-    "message carries (`bits` belong to address, status and value elements; an address element with bits has no "
-    "command to choose the message by); tests/specs/firmata.yaml declares a command per channel instead (64 of them)",
-)
+PICKED = """
+protocol: firmata_channel
+title: Firmata's channel messages, the pin in the command byte's low bits
+byte_order: little
+serial: {baudrate: 57600}
+framing:
+  elements:
+    content: {role: content}
+commands:
+  analog_message:
+    request: {fields: {kind: {type: u4, const: 0xE}, pin: u4, value: {type: u16, encoding: seven_bit}}}
+  report_analog:
+    request: {fields: {kind: {type: u4, const: 0xC}, pin: u4, enable: {type: u8, range: [0, 1]}}}
+  report_version:
+    request: {fields: {kind: {type: u8, const: 0xF9}}}
+"""
+
+
 def test_a_pin_in_the_command_byte(tmp_path: Path) -> None:
+    """What the refusal above points to: no command element, each message beginning with its command bits (a u4 or
+    a u8 constant: a prefix code) and the pin after them; each sized by its own fields (2, 3 or 1 byte)."""
     path = tmp_path / "channel.yaml"
-    path.write_text(CHANNEL.replace("PIN", "bits: {code: [7, 4], pin: [3, 0]}"), "utf-8")
+    path.write_text(PICKED, "utf-8")
     module = generate_and_import(path, tmp_path / "out", "firmata_channel")
     message = module.decode(bytes.fromhex("e3 7f 07"), module.Direction.REQUEST)
-    assert (message.pin, message.value) == (3, 1023)
+    assert message == module.AnalogMessageRequest(pin=3, value=1023)
+    assert module.encode(module.ReportAnalogRequest(pin=5, enable=1)) == bytes.fromhex("c5 01")
+    stream = bytes.fromhex("f9 c5 01 e3 7f 07 f9")
+    parser = module.StreamParser(module.Direction.REQUEST)
+    found = [m for byte in stream for m in parser.feed(bytes([byte]))]
+    assert [type(m).__name__ for m in found] == [
+        "ReportVersionRequest",
+        "ReportAnalogRequest",
+        "AnalogMessageRequest",
+        "ReportVersionRequest",
+    ]
 
 
 TEXT14 = """

@@ -1502,6 +1502,17 @@ local function frame_size(direction, layout, data, pos, request)
   if entry == nil then return nil end
   local content
   local message = entry.message
+  if entry.lead and entry.min ~= entry.max and not layout.transparency then
+    -- picked by their leading constant, each sized by its own bytes (lang/model/discriminator.py)
+    local at = pos + layout.prefix
+    if at + entry.lead.size - 1 > #data then return false end
+    local value = math.floor(unsigned(data:sub(at, at + entry.lead.size - 1), entry.lead.big) / entry.lead.divisor)
+      % entry.lead.modulus
+    local index = entry.lead.values[value]
+    if index == nil then return nil end
+    message = entry.by_size[index]
+    if message.size == nil then return nil end
+  end
   if entry.min == entry.max then
     content = entry.min
   elseif message and message.size and not layout.transparency then
@@ -1630,13 +1641,13 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     message = entry.subs[selector]
     if message == nil then error(string.format("no sub-command %d of this command", selector), 0) end
   end
-  if entry.lead then  -- requests that share the code: picked by their leading constant
+  if entry.lead then  -- messages that share the code (or carry none): picked by their leading constant
     local data = plain[content_index]
     if #data < entry.lead.size then error(string.format("content too short for its %s", entry.lead.field), 0) end
     local value = math.floor(unsigned(data:sub(1, entry.lead.size), entry.lead.big) / entry.lead.divisor)
       % entry.lead.modulus
     local index = entry.lead.values[value]
-    if index == nil then error(string.format("no request has %s %d", entry.lead.field, value), 0) end
+    if index == nil then error(string.format("no message has %s %d", entry.lead.field, value), 0) end
     message = entry.by_size[index]
   elseif entry.by_size then  -- requests that share the code: told apart by their content size
     local n = #plain[content_index]

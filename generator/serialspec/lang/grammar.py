@@ -685,10 +685,12 @@ COMMAND = Obj(
             "commands may share a code when no content size fits two of them: each is its own message, "
             "decoded by its size (u-blox: an empty payload polls, a full one sets), or when each content begins "
             "with a constant field of one width, no two equal: each is picked by that value before its size "
-            "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
-            "its message is known), unless the requests sharing the code, picked by a constant, have one fixed size "
-            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way. Only "
-            "requests are picked so (replies that share a code are chosen by the request they answer).",
+            "(below, RTCM 3's message number). Told apart by size, they need a length element (the size is read "
+            "before the message is known); picked by a constant, they need none where each has a size its own "
+            "bytes tell (fixed fields, a count before what it counts, a NUL-terminated text last: iRobot's sensor "
+            "queries `8E 16`, `8E 17`; Kondo ICS and MIDI below). Frames without a command element share the same "
+            "way. Replies that share a code are picked by a leading constant the same way, else chosen by the "
+            "request they answer (one of them `default: true`).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -782,10 +784,48 @@ COMMAND = Obj(
             "message has is refused in one line (`unknown message_number 1004`). Where some message has no such "
             "field, or widths or values clash, the messages are told apart by their content size alone, which no "
             "two may share. The reference says of each message that it is chosen by its constant. In a frame "
-            "without a length element, the requests that share a code need one fixed content size, which sizes "
-            "their frames (iRobot's Open Interface: `8E 16` asks for the voltage, `8E 17` the current, both "
-            "`code: 0x8E` with `packet_id: {type: u8, const: 22}` or `23`); such messages of different sizes "
-            "(Kondo ICS's command in the top bits of its first byte) are refused for now.",
+            "without a length element, each message picked so is sized by its own bytes (iRobot's Open Interface: "
+            "`8E 16` asks for the voltage, `8E 17` the current, both `code: 0x8E` with `packet_id: {type: u8, "
+            "const: 22}` or `23`; see the next example for messages of different sizes). Replies are picked the "
+            "same way where none is awaited; the reply a request awaits is read as that reply.",
+        ),
+        (
+            "A value in the low bits of the command byte (MIDI's status byte, Firmata, Kondo ICS): no command "
+            "element, each message beginning with its command bits",
+            {
+                "note_on": {
+                    "request": {
+                        "fields": {
+                            "status": {"type": "u4", "const": 0x9},
+                            "channel": "u4",
+                            "key": {"type": "u8", "range": [0, 127]},
+                            "velocity": {"type": "u8", "range": [0, 127]},
+                        }
+                    }
+                },
+                "pitch_bend": {
+                    "request": {
+                        "fields": {
+                            "status": {"type": "u4", "const": 0xE},
+                            "channel": "u4",
+                            "bend": {"type": "u16", "encoding": "seven_bit"},
+                        }
+                    }
+                },
+                "timing_clock": {"request": {"fields": {"status": {"type": "u8", "const": 0xF8}}}},
+            },
+            "With `framing: {elements: {content: {role: content}}}` (no header, no command element, no length), the "
+            "command byte's high bits are each message's leading constant bit field and its low bits the next "
+            "field: `93 3C 64` is note_on on channel 3, `E3 00 40` pitch_bend 8192 on channel 3, `F8` "
+            "timing_clock. Constants of different widths pick as a prefix code, each read as every value of the "
+            "widest it begins (`0x9` of 4 bits is 0x90..0x9F beside `0xF8` of 8 bits): none may begin another "
+            "(a `u4` 0xF beside `0xF8` would: they are then told apart by size, which needs a length element), "
+            "and the code is at most 256 values. Each "
+            "message is sized by its own bytes (fixed fields, a count before what it counts, a NUL-terminated "
+            "text last), so the frame needs no length; a stream parser finds each message's start by its "
+            "constant. Replies are picked the same way (Kondo ICS: the servo answers `05 3A 4C`, command bits 0 "
+            "and id 5, to the request `85 3A 4C`, command bits 4), with no `default: true`. The command element's "
+            "`bits` cannot say this: a code and a field in one element.",
         ),
     ),
 )

@@ -623,8 +623,19 @@ class SizeRule:
     # a reply's last bytes as many as a field of the request it answers says (`size_from: request.length`: the Tic's
     # and the Maestro's raw reads): the size needs that request, and with none there is no such reply
     request: str = ""
+    # messages that share a code (or carry none) picked by a leading constant, each of its own size (Kondo ICS): the
+    # constant read as (bytes, byte order, shift, mask), and each run of its values (lowest, highest, that one's rule)
+    lead: tuple[int, Literal["little", "big"], int, int] = (0, "big", 0, 0)
+    picks: tuple[tuple[int, int, SizeRule], ...] = ()
 
     def size(self, buffer: bytes, start: int, end: int, asked: Any = None) -> int | None:
+        if self.picks:
+            width, endian, shift, mask = self.lead
+            if end - start < width:
+                return None
+            value = int.from_bytes(buffer[start : start + width], endian) >> shift & mask
+            rule = next((rule for low, high, rule in self.picks if low <= value <= high), None)
+            return -1 if rule is None else rule.size(buffer, start, end, asked)
         if self.request:
             wanted = getattr(asked, self.request, None)
             return self.fixed + wanted if isinstance(wanted, int) else -1

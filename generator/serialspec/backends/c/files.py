@@ -29,7 +29,7 @@ from serialspec.backends.c.engine import GET, HEAD, TAIL, with_inner_lengths, wi
 from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
-from serialspec.backends.common.frames import layout_codes, layout_index, length_limits, sizing_message
+from serialspec.backends.common.frames import layout_codes, layout_index, length_limits
 from serialspec.encodings import seven_bit
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -43,6 +43,8 @@ from serialspec.lang.model import (
     fixed_bits,
     nul_ended,
     size_terms,
+    sizing_lead,
+    sizing_message,
 )
 from serialspec.transforms.replace import Replace
 
@@ -702,18 +704,30 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
 
 
 def leading_dispatch(ctx: Ctx, lead: Discriminator, values: tuple[tuple[str, object], ...]) -> list[str]:
-    """The decode dispatch's lines for requests that share a code, picked by their leading constant (RTCM 3's
-    message number: lang/model/discriminator.py): the content's first bytes read as one integer, shifted and
-    masked, then a switch on it."""
+    """The decode dispatch's lines for messages that share a code (or carry none), picked by their leading constant
+    (RTCM 3's message number, Kondo ICS's command bits: lang/model/discriminator.py): the content's first bytes read
+    as one integer, shifted and masked, then the message whose value or run of values it is."""
     P = ctx.P
+    body = [
+        "            unsigned long long lead;",
+        f"            if (n < {lead.size}u) {{ return {P}_E_LENGTH; }}",
+        f"            lead = {lead_value(lead)};",
+    ]
+    for low, high, message in lead.ranges():
+        body.append(f"            if ({lead_test(low, high)}) {{ {dec_call(ctx, message, values)} }}")
+    return [*body, f"            return {P}_E_UNKNOWN;"]
+
+
+def lead_value(lead: Discriminator) -> str:
+    """The leading constant of the content at `c`, as the C reads it: its bytes as one integer, shifted, masked."""
     order = list(range(lead.size)) if lead.endian == "big" else list(reversed(range(lead.size)))
-    high = lead.size - 1
-    read = " | ".join(f"((unsigned long long)c[{i}] << {8 * (high - k)}u)" for k, i in enumerate(order))
-    value = f"((({read}) >> {lead.shift}u) & {lead.mask:#x}ULL)"
-    body = [f"            if (n < {lead.size}u) {{ return {P}_E_LENGTH; }}", f"            switch ({value}) {{"]
-    for number, message in lead.values:
-        body.append(f"            case {number}ULL: {dec_call(ctx, message, values)}")
-    return [*body, f"            default: return {P}_E_UNKNOWN;", "            }"]
+    read = " | ".join(f"((unsigned long long)c[{i}] << {8 * (lead.size - 1 - k)}u)" for k, i in enumerate(order))
+    return f"((({read}) >> {lead.shift}u) & {lead.mask:#x}ULL)"
+
+
+def lead_test(low: int, high: int) -> str:
+    """`lead` is one value or within a run of values (a prefix code's narrower constant)."""
+    return f"lead == {low:#x}ULL" if low == high else f"lead >= {low:#x}ULL && lead <= {high:#x}ULL"
 
 
 def trailing_probe(ctx: Ctx, direction: Direction, layout: FrameLayout, sizes: list[int], command: int) -> list[str]:
@@ -1115,6 +1129,12 @@ def source(ctx: Ctx) -> str:
                 body.append("            }")
             elif d == Direction.REQUEST and (lead := discriminator(users)) is not None:
                 body += leading_dispatch(ctx, lead, values)  # requests that share a code: by their leading constant
+            elif len(users) > 1 and (lead := discriminator(users)) is not None:
+                for u in users:  # replies: the one awaited, else by their leading constant
+                    body.append(f"            if (expect == {kind_name(ctx, u)}) {{")
+                    body.append(f"                {dec_call(ctx, u, values)}")
+                    body.append("            }")
+                body += leading_dispatch(ctx, lead, values)
             elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
                     tests = [f"n >= {u.min_size}u"] if u.min_size else []
@@ -2147,36 +2167,73 @@ def code_key(P: str, code: int | None) -> str:
 
 
 def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
-    """The content size of each code whose one message is sized by its own leading fields (model.size_terms)."""
+    """The content size of each code whose one message is sized by its own leading fields (model.size_terms), or
+    whose messages are picked by their leading constant, each sized so (model.sizing_lead)."""
     rows = []
     for key, users in probe_keys(ctx, direction):
+        lead = sizing_lead(users)
+        if lead is not None:  # picked by a leading constant, each of its own size (runtime SizeRule.picks)
+            rows.append(picked_size_case(ctx, key, lead))
+            continue
         sizing = sizing_message(users)
-        found = size_terms(sizing.fields) if sizing is not None else None
-        text = nul_ended(sizing.fields) if sizing is not None and found is None else None
-        if text is not None:  # a NUL-terminated text ends the content: sized by its NUL (runtime SizeRule.nul)
-            rows.append(
-                f"        case {key}: {{\n            size_t i;\n"
-                f"            for (i = {text}u; i < avail; i++) {{\n"
-                f"                if (c[i] == 0u) {{\n                    return (long)(i + 1u);\n                }}\n"
-                f"            }}\n            return {ctx.P}__WAIT;\n        }}"
-            )
-            continue
-        if found is None:
-            continue
-        fixed, terms = found
-        body = [f"        case {key}:", f"            size = {fixed}L;"]
-        for offset, size, endian, factor in terms:
-            big = 1 if endian == "big" else 0
-            body.append(f"            if (avail < {offset + size}u) {{ return {ctx.P}__WAIT; }}")
-            body.append(f"            size += {factor}L * (long){ctx.p}__get(c + {offset}, {size}u, {big}u);")
-            ctx.helpers.add("get")
-        body.append("            return size;")
-        rows.append("\n".join(body))
+        lines = own_size_lines(ctx, sizing, "            ") if sizing is not None else None
+        if lines is not None and lines[0].lstrip().startswith("size_t"):  # a declaration: a block of its own
+            rows.append("\n".join([f"        case {key}: {{", *lines, "        }"]))
+        elif lines is not None:
+            rows.append("\n".join([f"        case {key}:", *lines]))
     return (
         f"    case {ctx.P}_{direction.name}:\n        switch (code) {{\n"
         + "\n".join(rows)
         + f"\n        default:\n            return {ctx.P}__NONE;\n        }}"
     )
+
+
+def own_size_lines(ctx: Ctx, message: Message, indent: str) -> list[str] | None:
+    """Lines that return a message's content size told by its own bytes at `c` (fixed fields and counts before what
+    they count: model.size_terms; or a NUL-terminated text last, sized by its NUL: runtime SizeRule.nul), WAIT
+    while those bytes have not come; None where its bytes do not tell it."""
+    P, p = ctx.P, ctx.p
+    found = size_terms(message.fields)
+    if found is not None:
+        fixed, terms = found
+        lines = [f"size = {fixed}L;"]
+        for offset, size, endian, factor in terms:
+            big = 1 if endian == "big" else 0
+            lines.append(f"if (avail < {offset + size}u) {{ return {P}__WAIT; }}")
+            lines.append(f"size += {factor}L * (long){p}__get(c + {offset}, {size}u, {big}u);")
+            ctx.helpers.add("get")
+        lines.append("return size;")
+    else:
+        text = nul_ended(message.fields)
+        if text is None:
+            return None
+        lines = [
+            "size_t i;",
+            f"for (i = {text}u; i < avail; i++) {{",
+            "    if (c[i] == 0u) {",
+            "        return (long)(i + 1u);",
+            "    }",
+            "}",
+            f"return {P}__WAIT;",
+        ]
+    return [indent + line for line in lines]
+
+
+def picked_size_case(ctx: Ctx, key: str, lead: Discriminator) -> str:
+    """The content size of a code whose messages are picked by their leading constant, each sized by its own
+    leading fields (model.sizing_lead): the constant read as leading_dispatch reads it, then that message's rule."""
+    body = [
+        f"        case {key}: {{",
+        "            unsigned long long lead;",
+        f"            if (avail < {lead.size}u) {{ return {ctx.P}__WAIT; }}",
+        f"            lead = {lead_value(lead)};",
+    ]
+    for low, high, message in lead.ranges():
+        lines = own_size_lines(ctx, message, "                ")
+        assert lines is not None  # sizing_lead: each message sized by its own bytes
+        body += [f"            if ({lead_test(low, high)}) {{ /* {message.command} */", *lines, "            }"]
+    body += [f"            return {ctx.P}__NONE;", "        }"]
+    return "\n".join(body)
 
 
 def span_decl_all(stuffed: dict[Direction, bool], P: str) -> str:

@@ -6,10 +6,15 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 from serialspec.backends import Unsupported
-from serialspec.lang.model import Direction, FrameElement, FrameLayout, Message, Protocol, fixed_bits
+from serialspec.lang.model import (
+    Direction,
+    FrameElement,
+    FrameLayout,
+    Message,
+    Protocol,
+    fixed_bits,
+)
 from serialspec.runtime.framing import Element, ElementKind, Layout
 
 KINDS: dict[str, ElementKind] = {
@@ -145,14 +150,3 @@ def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameEl
         for element in layout.optional:
             found.setdefault(element.name, element)
     return tuple(found.values())
-
-
-def sizing_message(messages: Sequence[Message]) -> Message | None:
-    """The message whose content size rule sizes the frames of a code without a length element: its one message, or
-    one of several that share the code, all of one fixed content size (requests picked by a leading constant, iRobot's
-    sensor queries 8E and a packet id); None where no one rule sizes them."""
-    if len(messages) == 1:
-        return messages[0]
-    if len({(m.min_size, m.max_size) for m in messages}) == 1 and messages[0].min_size == messages[0].max_size:
-        return messages[0]
-    return None

@@ -30,6 +30,7 @@ from serialspec.lang.model import (
     Device,
     DeviceModel,
     Direction,
+    Discriminator,
     ErratumCheck,
     Example,
     Field,
@@ -238,9 +239,15 @@ def shared_request_text(protocol: Protocol, message: Message) -> str:
     shares = f"shares code {code:#04x} with {names}" if code is not None else f"sent without a code as {names} are"
     lead = discriminator(sharing)
     if lead is not None:
-        value = next(v for v, m in lead.values if m.key == message.key)
-        return f"{shares}, chosen by its {lead.name} ({value}, the content's first {lead.bits} bits)"
+        return f"{shares}, {picked_text(lead, message)}"
     return f"{shares}, told apart by the content size"
+
+
+def picked_text(lead: Discriminator, message: Message) -> str:
+    """How a message sharing its code is picked by its leading constant (lang/model/discriminator.py)."""
+    value, bits = next((v, b) for v, b, m in lead.picks if m.key == message.key)
+    shown = f"{value:#x}" if len({b for _, b, _ in lead.picks}) > 1 else str(value)
+    return f"chosen by its {message.fields[0].name} ({shown}, the content's first {bits} bits)"
 
 
 def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
@@ -342,6 +349,15 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
         return ""
     askers = sorted(asking.get(message.key, ()))
     answers = ", ".join(f"`{a}`" for a in askers) or "no request"
+    peers = [
+        m
+        for c in protocol.commands
+        if (m := c.response) is not None and not m.error_reply and not c.selector
+        if (c.wire_code(Direction.RESPONSE) if protocol.layout(m).has_command else None) == code
+    ]
+    lead = discriminator(peers)
+    if lead is not None:  # (read alone, whatever the request)
+        return f"the layout of the replies to {answers}; {picked_text(lead, message)}"
     default = (
         "; a reply decoded without its request is read with this layout"
         if message.default_reply

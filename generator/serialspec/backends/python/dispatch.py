@@ -6,8 +6,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.backends.common.frames import sizing_message
-from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, discriminator, sizes_text
+from serialspec.lang.model import (
+    Command,
+    Direction,
+    Discriminator,
+    FrameLayout,
+    Message,
+    Protocol,
+    discriminator,
+    sizes_text,
+    sizing_lead,
+    sizing_message,
+)
 
 
 def message_function(verb: str, message: Message) -> str:
@@ -67,8 +77,8 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
 
 def size_dispatch(key: str, code: int | None, direction: Direction, messages: list[Message]) -> dict[str, Any]:
     """Requests that share one code (`key` in the dispatch table, `code` the number or None for frames without
-    one), told apart by their content size (the resolver checked that no size fits two): the decoder that picks
-    one by the size, for the code's entry in the dispatch table."""
+    one), or replies picked by a leading constant: the decoder that picks one by that constant or else by the
+    content size (the resolver checked that no size fits two), for the code's entry in the dispatch table."""
     code_name = "none" if code is None else f"{code:02x}"
     lead = discriminator(messages)
     found: dict[str, Any] = {
@@ -89,7 +99,9 @@ def size_dispatch(key: str, code: int | None, direction: Direction, messages: li
             "bits": lead.bits,
             "table": f"_{direction.name}_{code_name.upper()}_BY_{lead.name.upper()}",
             "entries": [(value, decoder_name(m)) for value, m in lead.values],
-            "known": ", ".join(f"{m.command}: {value}" for value, m in lead.values),
+            "known": lead.known(),
+            "mixed": len({bits for _, bits, _ in lead.picks}) > 1,
+            "who": "Requests" if direction == Direction.REQUEST else "Replies",
         }
     return found
 
@@ -126,7 +138,8 @@ class DirectionDispatch:
     single: dict[str, Message] = field(default_factory=dict)
     # each code's content size rule's message: its one message, or one of the requests sharing it, all of one fixed
     # size (picked by a leading constant: iRobot's sensor queries, 8E and a packet id)
-    sized: dict[str, Message] = field(default_factory=dict)
+    # or the leading constant that picks the message sizing it, each of its own size (Kondo ICS)
+    sized: dict[str, Message | Discriminator] = field(default_factory=dict)
     expected: list[tuple[str, str, str]] = field(default_factory=list)
     dispatchers: list[dict[str, Any]] = field(default_factory=list)
     size_dispatchers: list[dict[str, Any]] = field(default_factory=list)
@@ -156,8 +169,11 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         # the resolver allows several only for plain replies, one of them marked default, and for requests told
         # apart by their content size
         chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
-        if direction == Direction.REQUEST and len(users) > 1:
-            by_size = size_dispatch(key, codes[key], direction, [m for m, _, _, _ in users if m is not None])
+        shared = [m for m, _, _, _ in users if m is not None]
+        picked = direction == Direction.RESPONSE and len(shared) > 1 and discriminator(shared) is not None
+        if (direction == Direction.REQUEST or picked) and len(users) > 1:
+            # requests told apart by their leading constant or size; replies not awaited by their leading constant
+            by_size = size_dispatch(key, codes[key], direction, shared)
             found.size_dispatchers.append(by_size | value_arguments(layout))
             chosen = (None, by_size["name"], 0, None)
         found.dispatch.append((key, chosen[1]))
@@ -166,7 +182,7 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         if len(users) == 1 and users[0][0] is not None:
             found.single[key] = users[0][0]
         messages = [m for m, _, _, _ in users if m is not None]
-        sizing = sizing_message(messages) if len(messages) == len(users) else None
+        sizing = (sizing_message(messages) or sizing_lead(messages)) if len(messages) == len(users) else None
         if sizing is not None:
             found.sized[key] = sizing
         if direction == Direction.RESPONSE:

@@ -150,7 +150,13 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         codes[key] = {"message": _message(protocol, message)}
         codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
     for key, messages in sharing.items():
-        lead = discriminator(messages) if direction == Direction.REQUEST and "by_size" in codes[key] else None
+        if direction == Direction.RESPONSE and key != "error" and discriminator(messages) is not None:
+            # replies that share a code (or carry none), picked by their leading constant: as such requests are
+            entries = [_message(protocol, m) for m in messages]
+            highs = [e["max"] for e in entries]
+            codes[key] = {"by_size": entries, "min": min(e["min"] for e in entries)}
+            codes[key]["max"] = None if None in highs else max(highs)
+        lead = discriminator(messages) if "by_size" in codes[key] else None
         if lead is not None:  # picked by their leading constant (lang/model/discriminator.py), before their size
             if lead.size > 6:
                 raise Unsupported(f"a leading constant of {lead.bits} bits that picks a message (Lua numbers: 48)")

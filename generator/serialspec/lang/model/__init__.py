@@ -82,6 +82,15 @@ from serialspec.lang.model.discriminator import (
 from serialspec.lang.model.discriminator import (
     leading_constant as leading_constant,
 )
+from serialspec.lang.model.discriminator import (
+    sizing_lead as sizing_lead,
+)
+from serialspec.lang.model.discriminator import (
+    sizing_message as sizing_message,
+)
+from serialspec.lang.model.discriminator import (
+    why_not_picked as why_not_picked,
+)
 from serialspec.lang.model.examples import (
     Erratum as Erratum,
 )
@@ -201,6 +210,9 @@ from serialspec.lang.model.sizes import (
 )
 from serialspec.lang.model.sizes import (
     size_terms as size_terms,
+)
+from serialspec.lang.model.sizes import (
+    sized_by_itself as sized_by_itself,
 )
 from serialspec.lang.model.sizes import (
     sum_sizes as sum_sizes,

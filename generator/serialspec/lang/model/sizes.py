@@ -127,3 +127,9 @@ def nul_ended(fields: tuple[Field, ...]) -> int | None:
         return None
     sizes = [fixed_size(item) for item in fields[:-1]]
     return None if any(size is None for size in sizes) else sum(size or 0 for size in sizes)
+
+
+def sized_by_itself(fields: tuple[Field, ...]) -> bool:
+    """Whether a content's size follows from its own bytes (a fixed size, a count at a fixed offset, a NUL): what
+    sizes a frame that carries no length."""
+    return size_terms(fields) is not None or nul_ended(fields) is not None

@@ -30,7 +30,11 @@ from serialspec.lang.model import (
     leading_constant,
     replies_by_request,
     reply_to,
+    sized_by_itself,
     sizes_text,
+    sizing_lead,
+    sizing_message,
+    why_not_picked,
 )
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
@@ -524,10 +528,11 @@ class Commands(FieldResolver):
                     continue  # replies without a code read in the layout of their request: chosen by it
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
                 if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
-                    picked = discriminator([m for _, m in users])
-                    sizes = {(m.min_size, m.max_size) for _, m in users}
-                    if picked is not None and len(sizes) == 1 and len({size for pair in sizes for size in pair}) == 1:
-                        continue  # one fixed size, picked by a leading constant: no length needed (iRobot's sensors)
+                    alike = [m for _, m in users]
+                    if discriminator(alike) is not None and (sizing_lead(alike) or sizing_message(alike)):
+                        # picked by a leading constant, each sized by its own bytes (Kondo ICS), or of one fixed
+                        # size (iRobot's sensor queries): no length needed
+                        continue
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
                         shared = (
                             f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
@@ -536,9 +541,10 @@ class Commands(FieldResolver):
                             else f"{users[0][0].name!r} already sends requests without a code (the request frame has "
                             "no command element); such requests"
                         )
+                        reason = why_not_picked(alike)
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{shared} are told apart by their content size, which needs a length element",
+                            f"{shared} are told apart by their content size, which needs a length element{reason}",
                         )
                     elif discriminator([m for _, m in users]) is None:
                         self.check_sizes_differ(what, users, code is not None)
@@ -550,6 +556,11 @@ class Commands(FieldResolver):
                             f"{what} in {direction.value} frames is already used by {users[0][0].name!r}",
                         )
                     continue
+                replies = [m for _, m in users]
+                if discriminator(replies) is not None:
+                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                        self.check_self_sized(what, users)
+                    continue  # picked by their leading constant where the request is unknown (Kondo ICS)
                 defaults = [c.name for c, m in users if m.default_reply]
                 if len(defaults) != 1:
                     names = ", ".join(c.name for c, _ in users)
@@ -558,6 +569,18 @@ class Commands(FieldResolver):
                         f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
                         "layout a reply is decoded as when its request is unknown)",
                     )
+
+    def check_self_sized(self, what: str, users: list[tuple[Command, Message]]) -> None:
+        """Replies picked by their leading constant in a frame without a length element: each must be sized by its
+        own bytes (a fixed size, a count at a fixed offset, a NUL), which then sizes the frame."""
+        for command, message in users:
+            if not sized_by_itself(message.fields):
+                self.error(
+                    ("commands", command.name, "response"),
+                    f"{what} is shared by replies picked by their leading constant, in a frame without a length "
+                    "element: each needs a size its own bytes tell (fixed fields, a count before the rest, or a "
+                    "NUL-terminated text last)",
+                )
 
     def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]], coded: bool) -> None:
         """Requests that share a code are told apart by their content size: no size may fit two of them."""
@@ -770,7 +793,8 @@ def clash_text(users: list[tuple[Command, Message]], earlier: Message, message: 
 def codeless_replies(commands: list[Command], framing: Framing) -> bool:
     """One response layout without a command element, length, terminator or transform, whose replies (all awaited,
     none unsolicited) differ in size: the frame cannot size a reply, the reply awaited does (Framing.by_request).
-    FEETECH's and DYNAMIXEL's status replies carry a length: they are read alone."""
+    Replies a leading constant picks, each of a size its own bytes tell (Kondo ICS), need none; FEETECH's and
+    DYNAMIXEL's status replies carry a length: both are read alone."""
     layouts = framing.alternatives.get(Direction.RESPONSE, ())
     if framing.by_command or len(layouts) != 1:
         return False
@@ -778,8 +802,8 @@ def codeless_replies(commands: list[Command], framing: Framing) -> bool:
     if layout.has_command or layout.length is not None or layout.trailer or layout.transparency is not None:
         return False
     replies = [m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE]
-    if len(replies) < 2 or any(m.unsolicited for m in replies):
-        return False
+    if len(replies) < 2 or any(m.unsolicited for m in replies) or sizing_lead(replies) is not None:
+        return False  # (replies picked by a leading constant, each sized by its own bytes, are read alone)
     return len({(m.min_size, m.max_size) for m in replies}) > 1 or replies[0].min_size != replies[0].max_size
 
 

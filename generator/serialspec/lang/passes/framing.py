@@ -201,7 +201,14 @@ class FramingPass(FieldResolver):
             self.error((*path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
         for key in ("bits", "flags"):  # only a value the messages carry shows its bits: elsewhere they would be lost
             if key in item and role not in VALUE_ROLES and role in ROLES:
-                self.error((*path, key), f"`{key}` belongs to an address, status or value element, not a {role}")
+                hint = (
+                    " (a value in the command byte's low bits, MIDI style: leave out the command element and begin "
+                    "each message with its code as a constant bit field, `kind: {type: u4, const: 0xE}`, then "
+                    "`pin: u4`; see 'messages picked by their leading constant')"
+                    if key == "bits" and role == "command"
+                    else ""
+                )
+                self.error((*path, key), f"`{key}` belongs to an address, status or value element, not a {role}{hint}")
         bits: tuple[Any, ...] = ()
         bits_class = ""
         if "bits" in item and scalar is not None and role in VALUE_ROLES:

@@ -21,6 +21,7 @@ from serialspec.backends.python.optimize import content_unpacked
 from serialspec.backends.python.simulator import import_order
 from serialspec.lang.model import (
     Direction,
+    Discriminator,
     Message,
     Protocol,
     replies_by_request,
@@ -128,7 +129,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         dispatchers += table.dispatchers
         size_dispatchers += table.size_dispatchers
         dispatch, sizes, single, expected = table.dispatch, table.sizes, table.single, table.expected
-        sized = {key: single.get(key) or table.sized[key] for key, _ in dispatch if key in single or key in table.sized}
+        sized: dict[str, Message | Discriminator] = {
+            key: single.get(key) or table.sized[key] for key, _ in dispatch if key in single or key in table.sized
+        }
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
         requesting = protocol.framing.requesting

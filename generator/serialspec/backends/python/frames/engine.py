@@ -19,6 +19,7 @@ from serialspec.checksums.base import Import
 from serialspec.lang.model import (
     Bytes,
     Direction,
+    Discriminator,
     FrameElement,
     FrameLayout,
     Message,
@@ -125,8 +126,15 @@ def layout_lines(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> l
     return lines
 
 
-def size_rule(message: Message) -> str | None:
-    """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
+def size_rule(sizing: Message | Discriminator) -> str | None:
+    """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or for
+    messages picked by a leading constant, each sized so (model.sizing_lead); None otherwise."""
+    if isinstance(sizing, Discriminator):
+        picks = [(low, high, size_rule(m)) for low, high, m in sizing.ranges()]
+        shown = ", ".join(f"({low:#x}, {high:#x}, {rule})" for low, high, rule in picks)
+        lead = f"({sizing.size}, {sizing.endian!r}, {sizing.shift}, {sizing.mask:#x})"
+        return f"SizeRule(0, lead={lead}, picks=({shown},))"
+    message = sizing
     found = size_terms(message.fields)
     text = nul_ended(message.fields)
     *before, last = message.fields or (None,)
@@ -148,7 +156,7 @@ def codec_lines(
     protocol: Protocol,
     direction: Direction,
     sizes: list[tuple[str, int, int | None]],
-    messages: dict[str, Message],
+    messages: dict[str, Message | Discriminator],
 ) -> tuple[list[str], set[str]]:
     """`_<DIRECTION>_FRAMES = FrameCodec(...)`: the layouts, content sizes by code and, without a length, size
     rules by code (`messages`: the one message of each code, where there is one); and the runtime.framing names

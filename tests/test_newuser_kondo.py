@@ -29,16 +29,16 @@ def test_the_manuals_example_frame() -> None:
 
 def test_what_the_loader_says() -> None:
     """One line each, at the command. The reference (commands.NAME `code`, and the leading-constant paragraph: 'or
-    all those of a frame without a command element') did not say a length element is needed, nor that replies are
-    never picked so; it says both now (the grammar's text, checked here)."""
+    all those of a frame without a command element') did not say a length element is needed, nor when replies are
+    picked so; it says both now (the grammar's text, checked here)."""
     with pytest.raises(SpecErrors) as caught:
         load_protocol(SPEC)
     text = str(caught.value)
     assert "such requests are told apart by their content size, which needs a length element" in text
-    assert "a codeless reply is shared by the replies of set_position, read_parameter, write_parameter" in text
+    assert "such responses are told apart by their content size, which needs a length element (or mark one" in text
     reference = (Path(__file__).parent.parent / "docs" / "language.md").read_text("utf-8")
     assert "Either way the frame needs a length element" in reference
-    assert "Only requests are picked so" in reference
+    assert "Replies that share a code are told apart the same way (a length element needed)" in reference
     assert "are refused for now" in reference
 
 

@@ -1876,20 +1876,20 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     message = entry.subs[selector]
     if message == nil then error(string.format("no sub-command %d of this command", selector), 0) end
   end
-  if entry.lead then  -- requests that share the code: picked by their leading constant
+  if entry.lead then  -- messages that share the code: picked by their leading constant
     local data = plain[content_index]
     if #data < entry.lead.size then error(string.format("content too short for its %s", entry.lead.field), 0) end
     local value = math.floor(unsigned(data:sub(1, entry.lead.size), entry.lead.big) / entry.lead.divisor)
       % entry.lead.modulus
     local index = entry.lead.values[value]
-    if index == nil then error(string.format("no request has %s %d", entry.lead.field, value), 0) end
+    if index == nil then error(string.format("no message has %s %d", entry.lead.field, value), 0) end
     message = entry.by_size[index]
-  elseif entry.by_size then  -- requests that share the code: told apart by their content size
+  elseif entry.by_size then  -- messages that share the code: told apart by their content size
     local n = #plain[content_index]
     for _, layout in ipairs(entry.by_size) do
       if n >= layout.min and (layout.max == nil or n <= layout.max) then message = layout end
     end
-    if message == nil then error(string.format("no request of this code has %d content bytes", n), 0) end
+    if message == nil then error(string.format("no message of this code has %d content bytes", n), 0) end
   end
   local title = message.command .. (message.subcommand and "." .. message.subcommand or "")
   root:set_text(string.format("%s %s %s", SPEC.title, direction_name, title))

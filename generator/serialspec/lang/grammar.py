@@ -606,7 +606,12 @@ MESSAGE = Obj(
             default=False,
             example=True,
         ),
-        "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "answers": Str(
+            "For a response: the request (command or command.subcommand) it answers, if another. Replies that "
+            "share the code of that request's own reply, told apart by their size (none `default`), answer it "
+            "beside it: the client returns whichever comes (see `code`).",
+            example="device_ping",
+        ),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
             "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
@@ -650,7 +655,8 @@ MESSAGE = Obj(
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
-            "request it answers is unknown; the others are chosen by the request they answer. Code-less replies of "
+            "request it answers is unknown; the others are chosen by the request they answer. Without one, such "
+            "replies are told apart by their content size (see `code`). Code-less replies of "
             "different sizes in one layout with no length element, terminator or transform are sized by the reply "
             "awaited: a stream parser takes them only while it awaits one (`expect`, as the client does).",
             default=False,
@@ -687,8 +693,10 @@ COMMAND = Obj(
             "with a constant field of one width, no two equal: each is picked by that value before its size "
             "(below, RTCM 3's message number). Either way the frame needs a length element (its size is read before "
             "its message is known), unless the requests sharing the code, picked by a constant, have one fixed size "
-            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way. Only "
-            "requests are picked so (replies that share a code are chosen by the request they answer).",
+            "(iRobot's sensor queries `8E 16`, `8E 17`). Frames without a command element share the same way. Replies "
+            "that share a code are told apart the same way (a length element needed) where none of them is marked "
+            "`default: true` (below, SPS30's measured values: 40, 20 or 0 bytes); with one, they are chosen by the "
+            "request they answer.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -786,6 +794,36 @@ COMMAND = Obj(
             "their frames (iRobot's Open Interface: `8E 16` asks for the voltage, `8E 17` the current, both "
             "`code: 0x8E` with `packet_id: {type: u8, const: 22}` or `23`); such messages of different sizes "
             "(Kondo ICS's command in the top bits of its first byte) are refused for now.",
+        ),
+        (
+            "Replies told apart by their size (Sensirion SPS30: Read Measured Values, 0x03, answers 40 bytes of "
+            "floats, or 20 bytes of integers after Start Measurement asked for them, or nothing when no new values "
+            "are there)",
+            {
+                "read_measured_values": {
+                    "code": 0x03,
+                    "request": {"fields": {}},
+                    "response": {"fields": {"values": {"type": "array", "of": "f32", "count": 10}}},
+                },
+                "measured_values_u16": {
+                    "code": 0x03,
+                    "response": {
+                        "answers": "read_measured_values",
+                        "fields": {"values": {"type": "array", "of": "u16", "count": 10}},
+                    },
+                },
+                "no_new_values": {"code": 0x03, "response": {"answers": "read_measured_values", "fields": {}}},
+            },
+            "Replies that share a code (and layout), none of them marked `default: true`, are each their own "
+            "message, told apart by their content size like requests (a leading constant picks them likewise): "
+            "decode without the request, the stream parser however the bytes are split, the C decoder and parser "
+            "and the Wireshark dissector read a 20-byte reply under 0x03 as `measured_values_u16`. The frame needs "
+            "a length element, and no content size may fit two of them: a tie is refused in one line naming both "
+            "(`code 0x03 in response frames is already used by 'read_measured_values', and a content of 40 bytes "
+            "fits both`). A reply whose `answers` names a request answers it beside that request's own: the "
+            "client's method returns whichever comes, whole (`ReadMeasuredValuesResponse | "
+            "MeasuredValuesU16Response | NoNewValuesResponse`); the simulator answers with the request's own "
+            "reply.",
         ),
     ),
 )

@@ -6,12 +6,13 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.lang.frozen import frozen
-from serialspec.lang.model.commands import Command, Message
+from serialspec.lang.model.commands import Command, Message, replies_by_request, reply_to
 from serialspec.lang.model.device import Device
 from serialspec.lang.model.examples import Erratum, Example
 from serialspec.lang.model.fields import EnumDef, FlagsDef, Table
 from serialspec.lang.model.framing import ErrorReply, FrameLayout, Framing, Serial
 from serialspec.lang.model.text_frames import TextFrame
+from serialspec.runtime.message import Direction
 
 
 @frozen
@@ -47,6 +48,33 @@ class Protocol:
     @cached_property
     def _commands_by_name(self) -> dict[str, Command]:  # emitters look commands up per message
         return {c.name: c for c in self.commands}
+
+    def reply_alternatives(self, request: Message) -> tuple[Message, ...]:
+        """The replies that answer `request` besides its own (`reply_to`'s): the others that share its code, none of
+        them the `default`, told apart by their content size, and answer the same request (`answers`). SPS30's
+        Read Measured Values: 40 bytes of floats, 20 of integers or none at all. A client returns whichever
+        comes."""
+        reply = reply_to(request, replies_by_request(self.messages()))
+        return self._sized_replies.get(reply.key, ()) if reply is not None else ()
+
+    @cached_property
+    def _sized_replies(self) -> dict[str, tuple[Message, ...]]:
+        groups: dict[tuple[int, str], list[Message]] = {}
+        for command in self.commands:
+            reply, code = command.response, command.wire_code(Direction.RESPONSE)
+            if reply is None or code is None or reply.error_reply or not self.layout(reply).has_command:
+                continue
+            groups.setdefault((code, self.layout(reply).name), []).append(reply)
+        found: dict[str, tuple[Message, ...]] = {}
+        for group in groups.values():
+            if len(group) < 2 or any(m.default_reply for m in group):
+                continue
+            for reply in group:
+                asked = reply.answers or reply.key
+                others = [m for m in group if m is not reply and not m.unsolicited and (m.answers or m.key) == asked]
+                if others and not reply.unsolicited:
+                    found[reply.key] = tuple(others)
+        return found
 
     def layout(self, message: Message) -> FrameLayout:
         """The layout a message's frames travel in (its command's `layout`, else its direction's first; the error

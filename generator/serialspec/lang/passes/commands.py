@@ -523,25 +523,34 @@ class Commands(FieldResolver):
                 if len(users) < 2 or (code is None and framing.by_request(direction)):
                     continue  # replies without a code read in the layout of their request: chosen by it
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
-                if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
+                by_size = direction == Direction.REQUEST or not any(m.default_reply for _, m in users)
+                if by_size and not any(c.selector for c, _ in users):
                     picked = discriminator([m for _, m in users])
                     sizes = {(m.min_size, m.max_size) for _, m in users}
-                    if picked is not None and len(sizes) == 1 and len({size for pair in sizes for size in pair}) == 1:
+                    one_size = len(sizes) == 1 and len({size for pair in sizes for size in pair}) == 1
+                    if direction == Direction.REQUEST and picked is not None and one_size:
                         continue  # one fixed size, picked by a leading constant: no length needed (iRobot's sensors)
+                    kind = direction.value
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
                         shared = (
-                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
+                            f"{what} in {kind} frames is already used by {users[0][0].name!r}; {kind}s that share "
                             "a code"
                             if code is not None
-                            else f"{users[0][0].name!r} already sends requests without a code (the request frame has "
-                            "no command element); such requests"
+                            else f"{users[0][0].name!r} already sends {kind}s without a code (the {kind} frame has "
+                            f"no command element); such {kind}s"
+                        )
+                        other = (
+                            ""
+                            if direction == Direction.REQUEST
+                            else " (or mark one `default: true`: the reply a frame is decoded as when its request is "
+                            "unknown, the others chosen by the request they answer)"
                         )
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{shared} are told apart by their content size, which needs a length element",
+                            f"{shared} are told apart by their content size, which needs a length element{other}",
                         )
                     elif discriminator([m for _, m in users]) is None:
-                        self.check_sizes_differ(what, users, code is not None)
+                        self.check_sizes_differ(what, users, code is not None, direction)
                     continue
                 if any(c.selector for c, _ in users):
                     for command, _ in users[1:]:
@@ -559,8 +568,12 @@ class Commands(FieldResolver):
                         "layout a reply is decoded as when its request is unknown)",
                     )
 
-    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]], coded: bool) -> None:
-        """Requests that share a code are told apart by their content size: no size may fit two of them."""
+    def check_sizes_differ(
+        self, what: str, users: list[tuple[Command, Message]], coded: bool, direction: Direction
+    ) -> None:
+        """Requests (or replies none of which is the `default`) that share a code are told apart by their content
+        size: no size may fit two of them."""
+        kind = direction.value
         for index, (command, message) in enumerate(users):
             for other, earlier in users[:index]:
                 low = max(message.min_size, earlier.min_size)
@@ -568,11 +581,11 @@ class Commands(FieldResolver):
                 if not highs or low <= min(highs):
                     plural = "" if low == 1 else "s"
                     used = (
-                        f"{what} in request frames is already used by {other.name!r}"
+                        f"{what} in {kind} frames is already used by {other.name!r}"
                         if coded
-                        else f"{other.name!r} also sends requests without a code"
+                        else f"{other.name!r} also sends {kind}s without a code"
                     )
-                    apart = "requests that share a code" if coded else "requests without a code"
+                    apart = f"{kind}s that share a code" if coded else f"{kind}s without a code"
                     self.error(
                         ("commands", command.name),
                         f"{used}, and a content of {low} byte{plural} fits both ({apart} are told apart by their "

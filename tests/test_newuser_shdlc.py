@@ -21,7 +21,7 @@ from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.lang import SpecErrors, load_protocol
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, DeviceError
 
 shdlc = pytest.importorskip("sensirion_shdlc_driver.serial_frame_builder")
 Mosi = shdlc.ShdlcSerialMosiFrameBuilder
@@ -168,19 +168,21 @@ def test_read_measured_values_replies_by_size(sp: ModuleType) -> None:
 
 
 def test_the_client_returns_whichever_reply_comes(sp: ModuleType) -> None:
-    """The client's read_measured_values() returns the reply the device sends, whole, whichever of the three."""
+    """The client's read_measured_values() returns the reply the device sends, whole, whichever of the three; an
+    empty reply whose state says an error (7E 00 03 43 00 B9 7E) raises DeviceError naming it."""
     controller, device = os.openpty()
     tty.setraw(controller)
     tty.setraw(device)
     sizes = [struct.pack(">10H", *range(10)), b"", struct.pack(">10f", *range(10))]
+    states = [0, 0, 0, 0x43]  # then 7E 00 03 43 00 B9 7E: no data, the state a refusal
 
     def device_side() -> None:
-        for data in sizes:
+        for data, state in zip([*sizes, b""], states, strict=True):
             asked = b""
             while asked.count(b"\x7e") < 2:
                 asked += os.read(controller, 64)
             assert sp.decode(asked, sp.Direction.REQUEST) == sp.ReadMeasuredValuesRequest(address=0)
-            os.write(controller, miso_frame(0, 3, 0, data))
+            os.write(controller, miso_frame(0, 3, state, data))
 
     thread = threading.Thread(target=device_side, daemon=True)
     thread.start()
@@ -189,6 +191,8 @@ def test_the_client_returns_whichever_reply_comes(sp: ModuleType) -> None:
             os.ttyname(device), timeout=2.0
         ) as client:
             replies = [client.read_measured_values(0) for _ in sizes]
+            with pytest.raises(DeviceError, match="command_not_allowed_in_current_state") as refused:
+                client.read_measured_values(0)
     finally:
         thread.join(2.0)
         os.close(controller)
@@ -199,6 +203,7 @@ def test_the_client_returns_whichever_reply_comes(sp: ModuleType) -> None:
         "ReadMeasuredValuesResponse",
     ]
     assert replies[0].typical_particle_size == 9
+    assert isinstance(refused.value.reply, sp.NoNewValuesResponse)
 
 
 def test_replies_of_one_size_under_one_code_are_refused(tmp_path: Path) -> None:

@@ -6,7 +6,7 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.lang.frozen import frozen
-from serialspec.lang.model.commands import Command, Message, replies_by_request, reply_to
+from serialspec.lang.model.commands import Command, Message, replies_by_request, reply_to, sized_apart
 from serialspec.lang.model.device import Device
 from serialspec.lang.model.examples import Erratum, Example
 from serialspec.lang.model.fields import EnumDef, FlagsDef, Table
@@ -51,7 +51,8 @@ class Protocol:
 
     def reply_alternatives(self, request: Message) -> tuple[Message, ...]:
         """The replies that answer `request` besides its own (`reply_to`'s): the others that share its code, none of
-        them the `default`, told apart by their content size, and answer the same request (`answers`). SPS30's
+        them the `default`, told apart by their content size (sized_apart), and answer the same request
+        (`answers`). SPS30's
         Read Measured Values: 40 bytes of floats, 20 of integers or none at all. A client returns whichever
         comes."""
         reply = reply_to(request, replies_by_request(self.messages()))
@@ -59,15 +60,16 @@ class Protocol:
 
     @cached_property
     def _sized_replies(self) -> dict[str, tuple[Message, ...]]:
-        groups: dict[tuple[int, str], list[Message]] = {}
+        groups: dict[int | None, list[Message]] = {}
         for command in self.commands:
-            reply, code = command.response, command.wire_code(Direction.RESPONSE)
-            if reply is None or code is None or reply.error_reply or not self.layout(reply).has_command:
+            reply = command.response
+            if reply is None or reply.error_reply:
                 continue
-            groups.setdefault((code, self.layout(reply).name), []).append(reply)
+            code = command.wire_code(Direction.RESPONSE) if self.layout(reply).has_command else None
+            groups.setdefault(code, []).append(reply)
         found: dict[str, tuple[Message, ...]] = {}
-        for group in groups.values():
-            if len(group) < 2 or any(m.default_reply for m in group):
+        for code, group in groups.items():
+            if not sized_apart(group, code is None and self.framing.by_request(Direction.RESPONSE)):
                 continue
             for reply in group:
                 asked = reply.answers or reply.key

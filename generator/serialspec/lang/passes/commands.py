@@ -586,6 +586,8 @@ class Commands(FieldResolver):
                         else f"{other.name!r} also sends {kind}s without a code"
                     )
                     apart = f"{kind}s that share a code" if coded else f"{kind}s without a code"
+                    if direction == Direction.RESPONSE:
+                        apart += ", none of them `default: true`,"
                     self.error(
                         ("commands", command.name),
                         f"{used}, and a content of {low} byte{plural} fits both ({apart} are told apart by their "

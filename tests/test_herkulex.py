@@ -130,7 +130,8 @@ def test_the_simulator_answers_the_client_and_raw_requests(hx: ModuleType) -> No
             ("      mask: 0xFE\n      covers: [size", "      reply_code: code\n      mask: 0xFE\n      covers: [size"),
             ("`reply_code` goes on the command element"),
         ),
-        (("    code: 0x04\n", "    code: 0x47\n"), "code 0x47 is shared by the replies of ram_read, stat"),
+        # (ram_read under 0x47 would share its reply code with stat's: replies of 4 bytes or more and of 2, told
+        # apart by their size, as SPS30's measured values are; tests/test_newuser_shdlc.py refuses a tie)
     ],
 )
 def test_mistakes_in_a_reply_code(tmp_path: Path, change: tuple[str, str], said: str) -> None:

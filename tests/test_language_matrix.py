@@ -823,6 +823,20 @@ CASES["requests sharing a code, by content size, frame engine"] = Case(
     CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
     commands=SHARED_CODE,
 )
+# Replies that share a code, none of them `default`, told apart by their content size (SPS30's measured values: 40
+# bytes of floats, 20 of integers, or none): probe's reply and two more that answer probe, in the usual frame and in
+# one the frame engine reads
+SHARED_REPLIES = {
+    "probe_short": {"code": 1, "response": {"answers": "probe", "fields": {"w": "u8"}}},
+    "probe_empty": {"code": 1, "response": {"answers": "probe", "fields": {}}},
+}
+CASES["replies sharing a code, by content size"] = Case({"v": "u16"}, {"w": "u8", "x": "u32"}, commands=SHARED_REPLIES)
+CASES["replies sharing a code, by content size, frame engine"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "x": "u32"},
+    CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
+    commands=SHARED_REPLIES,
+)
 # Messages picked by their leading constant (lang/model/discriminator.py), before sizes that overlap: RTCM 3's frame
 # without a command element, each request's content beginning with its 12-bit message number (`descriptor`'s
 # counted string makes 4 bytes or more, probe's 5); and requests that share a code, picked by a leading u8

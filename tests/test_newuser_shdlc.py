@@ -2,13 +2,17 @@
 checked against sensirion-shdlc-driver: its MOSI frame builder writes our golden requests (byte stuffing of 7E, 7D,
 11 and 13 included), its MISO frame builder parses the replies we encode (address, command, state, data), and replies
 made with its stuffing and checksum decode to the values it read. The datasheet's frames are the spec's examples.
-Two gaps are strict xfails: replies that share a code told apart by their size (Read Measured Values answers 40
-bytes of floats, 20 bytes of integers, or nothing when there is no new value), and an error reply that the state
-byte alone marks (state != 0, no data)."""
+Read Measured Values answers 40 bytes of floats, 20 bytes of integers, or nothing when there is no new value: three
+replies under one code, told apart by their size. One gap is a strict xfail: an error reply that the state byte
+alone marks (state != 0, no data)."""
 
 from __future__ import annotations
 
+import importlib
+import os
 import struct
+import threading
+import tty
 from pathlib import Path
 from types import ModuleType
 
@@ -16,7 +20,8 @@ import pytest
 from conftest import examples, generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.errors import DecodeError
+from serialspec.lang import SpecErrors, load_protocol
+from serialspec.runtime.errors import DecodeError, DeviceError
 
 shdlc = pytest.importorskip("sensirion_shdlc_driver.serial_frame_builder")
 Mosi = shdlc.ShdlcSerialMosiFrameBuilder
@@ -137,35 +142,90 @@ def test_a_bad_checksum_is_refused(sp: ModuleType) -> None:
         sp.decode(bytes(frame), sp.Direction.RESPONSE)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: replies that share a code are told apart by the request they answer (`default: true` and "
-    "`expect`), never by their size, though a length element gives it (requests that share a code are told apart by "
-    "size). SPS30 Read Measured Values (0x03) answers 40 bytes (floats) or 20 (u16, after Start Measurement with "
-    "format 5) or 0 (no new values): each as a response-only command with `answers: read_measured_values` is refused "
-    "without a `default`, and with one a reply of another size does not decode without `expect`",
-)
-def test_read_measured_values_replies_by_size(tmp_path: Path) -> None:
-    from serialspec.cli import main
+def test_read_measured_values_replies_by_size(sp: ModuleType) -> None:
+    """Read Measured Values (0x03) answers 40 bytes of floats, 20 of integers (after Start Measurement with format 5)
+    or none (no new values): three replies under one code, told apart by their size without the request, by decode
+    and by the stream parser however the bytes are split."""
+    ok = sp.StateBits(error=0, code=0)
+    floats = sp.ReadMeasuredValuesResponse(0, ok, *[float(i) for i in range(10)])
+    integers = sp.MeasuredValuesU16Response(0, ok, *range(100, 110))
+    empty = sp.NoNewValuesResponse(0, ok)
+    frames = [
+        miso_frame(0, 3, 0, struct.pack(">10f", *range(10))),
+        miso_frame(0, 3, 0, struct.pack(">10H", *range(100, 110))),
+        miso_frame(0, 3, 0, b""),
+    ]
+    for frame, message in zip(frames, [floats, integers, empty], strict=True):
+        assert sp.decode(frame, sp.Direction.RESPONSE) == message
+        assert sp.encode(message) == frame
+    stream = b"".join(frames[::-1] + frames)
+    for step in (1, 5):
+        parser = sp.StreamParser(sp.Direction.RESPONSE)
+        seen = [m for i in range(0, len(stream), step) for m in parser.feed(stream[i : i + step])]
+        assert seen == [empty, integers, floats, floats, integers, empty]
+    with pytest.raises(DecodeError, match="fits none"):
+        sp.decode(miso_frame(0, 3, 0, b"\x00" * 2), sp.Direction.RESPONSE)
 
-    text = SPEC.read_text().replace(
-        "  sleep:\n    code: 0x10",
-        "  measured_values_u16:\n    code: 0x03\n    response:\n      answers: read_measured_values\n"
-        "      fields: {values: {type: array, of: u16, count: 10}}\n"
-        "  no_new_values:\n    code: 0x03\n    response:\n      answers: read_measured_values\n      fields: {}\n"
-        "  sleep:\n    code: 0x10",
-    )
-    spec = tmp_path / "sizes.yaml"
+
+def test_the_client_returns_whichever_reply_comes(sp: ModuleType) -> None:
+    """The client's read_measured_values() returns the reply the device sends, whole, whichever of the three; an
+    empty reply whose state says an error (7E 00 03 43 00 B9 7E) raises DeviceError naming it."""
+    controller, device = os.openpty()
+    tty.setraw(controller)
+    tty.setraw(device)
+    sizes = [struct.pack(">10H", *range(10)), b"", struct.pack(">10f", *range(10))]
+    states = [0, 0, 0, 0x43]  # then 7E 00 03 43 00 B9 7E: no data, the state a refusal
+
+    def device_side() -> None:
+        for data, state in zip([*sizes, b""], states, strict=True):
+            asked = b""
+            while asked.count(b"\x7e") < 2:
+                asked += os.read(controller, 64)
+            assert sp.decode(asked, sp.Direction.REQUEST) == sp.ReadMeasuredValuesRequest(address=0)
+            os.write(controller, miso_frame(0, 3, state, data))
+
+    thread = threading.Thread(target=device_side, daemon=True)
+    thread.start()
+    try:
+        with importlib.import_module(f"{sp.__name__}.client").ShdlcSps30Client(
+            os.ttyname(device), timeout=2.0
+        ) as client:
+            replies = [client.read_measured_values(0) for _ in sizes]
+            with pytest.raises(DeviceError, match="command_not_allowed_in_current_state") as refused:
+                client.read_measured_values(0)
+    finally:
+        thread.join(2.0)
+        os.close(controller)
+        os.close(device)
+    assert [type(r).__name__ for r in replies] == [
+        "MeasuredValuesU16Response",
+        "NoNewValuesResponse",
+        "ReadMeasuredValuesResponse",
+    ]
+    assert replies[0].typical_particle_size == 9
+    assert isinstance(refused.value.reply, sp.NoNewValuesResponse)
+
+
+def test_replies_of_one_size_under_one_code_are_refused(tmp_path: Path) -> None:
+    """Two replies under 0x03 that a content of 40 bytes fits, neither `default`: one line, naming both."""
+    text = SPEC.read_text().replace("{type: u16,", "{type: f32,")  # the integers as floats: 40 bytes too
+    spec = tmp_path / "tie.yaml"
     spec.write_text(text)
-    assert main(["decode", str(spec), miso_frame(0, 3, 0, b"").hex(), "--direction", "response"]) == 0
+    with pytest.raises(SpecErrors) as refused:
+        load_protocol(spec)
+    said = str(refused.value)
+    assert said.count("\n") == 0, said
+    assert "tie.yaml:" in said and "'read_measured_values'" in said and "measured_values_u16" in said
+    assert "a content of 40 bytes fits both" in said
 
 
 @pytest.mark.xfail(
     strict=True,
-    reason="language gap: an SHDLC reply whose state byte is not 0 carries no data (7E 00 03 43 00 B9 7E: command "
-    "not allowed in this state); the language marks an error reply by a flag in the command code (`error_flag`) or "
-    "another header (`error_value`), not by a status element's value, so it is refused as too short",
+    reason="language gap: an SHDLC reply whose state byte is not 0 carries no data (7E 00 D1 43 00 EB 7E: Read "
+    "Version refused, command not allowed in this state); the language marks an error reply by a flag in the command "
+    "code (`error_flag`) or another header (`error_value`), not by a status element's value, so it is refused as too "
+    "short (under 0x03 the empty reply `no_new_values` reads it, its state saying the error)",
 )
 def test_an_error_state_reply_without_data(sp: ModuleType) -> None:
-    message = sp.decode(miso_frame(0, 0x03, 0x43, b""), sp.Direction.RESPONSE)
+    message = sp.decode(miso_frame(0, 0xD1, 0x43, b""), sp.Direction.RESPONSE)
     assert int(message.state.code) == 0x43

@@ -1838,12 +1838,12 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     local index = entry.lead.values[value]
     if index == nil then error(string.format("no message has %s %d", entry.lead.field, value), 0) end
     message = entry.by_size[index]
-  elseif entry.by_size then  -- requests that share the code: told apart by their content size
+  elseif entry.by_size then  -- messages that share the code: told apart by their content size
     local n = #plain[content_index]
     for _, layout in ipairs(entry.by_size) do
       if n >= layout.min and (layout.max == nil or n <= layout.max) then message = layout end
     end
-    if message == nil then error(string.format("no request of this code has %d content bytes", n), 0) end
+    if message == nil then error(string.format("no message of this code has %d content bytes", n), 0) end
   end
   local title = message.command .. (message.subcommand and "." .. message.subcommand or "")
   root:set_text(string.format("%s %s %s", SPEC.title, direction_name, title))

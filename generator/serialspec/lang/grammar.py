@@ -606,7 +606,12 @@ MESSAGE = Obj(
             default=False,
             example=True,
         ),
-        "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "answers": Str(
+            "For a response: the request (command or command.subcommand) it answers, if another. Replies that "
+            "share the code of that request's own reply, told apart by their size (none `default`), answer it "
+            "beside it: the client returns whichever comes (see `code`).",
+            example="device_ping",
+        ),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
             "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
@@ -650,7 +655,8 @@ MESSAGE = Obj(
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
-            "request it answers is unknown; the others are chosen by the request they answer. Code-less replies of "
+            "request it answers is unknown; the others are chosen by the request they answer. Without one, such "
+            "replies are told apart by their content size (see `code`). Code-less replies of "
             "different sizes in one layout with no length element, terminator or transform are sized by the reply "
             "awaited: a stream parser takes them only while it awaits one (`expect`, as the client does).",
             default=False,
@@ -689,8 +695,9 @@ COMMAND = Obj(
             "before the message is known); picked by a constant, they need none where each has a size its own "
             "bytes tell (fixed fields, a count before what it counts, a NUL-terminated text last: iRobot's sensor "
             "queries `8E 16`, `8E 17`; Kondo ICS and MIDI below). Frames without a command element share the same "
-            "way. Replies that share a code are picked by a leading constant the same way, else chosen by the "
-            "request they answer (one of them `default: true`).",
+            "way. Replies that share a code are told apart the same way where none of them is marked `default: "
+            "true` (below, SPS30's measured values: 40, 20 or 0 bytes; Kondo ICS's replies by their command bits); "
+            "with one, they are chosen by the request they answer.",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -786,8 +793,8 @@ COMMAND = Obj(
             "two may share. The reference says of each message that it is chosen by its constant. In a frame "
             "without a length element, each message picked so is sized by its own bytes (iRobot's Open Interface: "
             "`8E 16` asks for the voltage, `8E 17` the current, both `code: 0x8E` with `packet_id: {type: u8, "
-            "const: 22}` or `23`; see the next example for messages of different sizes). Replies are picked the "
-            "same way where none is awaited; the reply a request awaits is read as that reply.",
+            "const: 22}` or `23`; see the next example for messages of different sizes). Replies that share a code, "
+            "none of them `default: true`, are picked the same way.",
         ),
         (
             "A value in the low bits of the command byte (MIDI's status byte, Firmata, Kondo ICS): no command "
@@ -826,6 +833,36 @@ COMMAND = Obj(
             "constant. Replies are picked the same way (Kondo ICS: the servo answers `05 3A 4C`, command bits 0 "
             "and id 5, to the request `85 3A 4C`, command bits 4), with no `default: true`. The command element's "
             "`bits` cannot say this: a code and a field in one element.",
+        ),
+        (
+            "Replies told apart by their size (Sensirion SPS30: Read Measured Values, 0x03, answers 40 bytes of "
+            "floats, or 20 bytes of integers after Start Measurement asked for them, or nothing when no new values "
+            "are there)",
+            {
+                "read_measured_values": {
+                    "code": 0x03,
+                    "request": {"fields": {}},
+                    "response": {"fields": {"values": {"type": "array", "of": "f32", "count": 10}}},
+                },
+                "measured_values_u16": {
+                    "code": 0x03,
+                    "response": {
+                        "answers": "read_measured_values",
+                        "fields": {"values": {"type": "array", "of": "u16", "count": 10}},
+                    },
+                },
+                "no_new_values": {"code": 0x03, "response": {"answers": "read_measured_values", "fields": {}}},
+            },
+            "Replies that share a code (and layout), none of them marked `default: true`, are each their own "
+            "message, told apart by their content size like requests (a leading constant picks them likewise): "
+            "decode without the request, the stream parser however the bytes are split, the C decoder and parser "
+            "and the Wireshark dissector read a 20-byte reply under 0x03 as `measured_values_u16`. The frame needs "
+            "a length element, and no content size may fit two of them: a tie is refused in one line naming both "
+            "(`code 0x03 in response frames is already used by 'read_measured_values', and a content of 40 bytes "
+            "fits both`). A reply whose `answers` names a request answers it beside that request's own: the "
+            "client's method returns whichever comes, whole (`ReadMeasuredValuesResponse | "
+            "MeasuredValuesU16Response | NoNewValuesResponse`); the simulator answers with the request's own "
+            "reply.",
         ),
     ),
 )

@@ -131,6 +131,9 @@ class Binding:
     # reply class -> its field holding the code of the request it answers (`request_code`), and each command's code
     code_fields: Mapping[type, str] = field(default_factory=dict)
     codes: Mapping[str, int] = field(default_factory=dict)
+    # request class -> the replies that answer it besides the one a transaction expects: replies that share that
+    # one's code, told apart by their content size (`answers`); the bus returns whichever comes
+    alternatives: Mapping[type, tuple[type, ...]] = field(default_factory=dict)
 
 
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
@@ -598,7 +601,7 @@ class Bus:
         finally:
             lock.release()
         self._refused(request, reply)
-        assert isinstance(reply, expect)
+        assert isinstance(reply, expect) or reply.__class__ in self.binding.alternatives.get(request.__class__, ())
         self._check_status(reply)
         return reply
 
@@ -829,7 +832,11 @@ class Bus:
         """Whether `message` is what the transaction waits for: the reply to `request` (or, with `key`, the reply
         whose attributes equal the key's values); any frame when there is no request."""
         if not isinstance(message, expect):
-            return request is not None and key is None and self._refusal(request, message)
+            if request is None or key is not None:
+                return False
+            if message.__class__ in self.binding.alternatives.get(request.__class__, ()):
+                return self.matches(request, message)
+            return self._refusal(request, message)
         if key is not None:
             return all(getattr(message, k, None) == v for k, v in key.items())
         return request is None or self.matches(request, message)

@@ -43,6 +43,7 @@ from serialspec.lang.model import (
     fixed_bits,
     nul_ended,
     size_terms,
+    sized_apart,
     sizing_lead,
     sizing_message,
 )
@@ -1127,15 +1128,11 @@ def source(ctx: Ctx) -> str:
                         body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
-            elif d == Direction.REQUEST and (lead := discriminator(users)) is not None:
-                body += leading_dispatch(ctx, lead, values)  # requests that share a code: by their leading constant
-            elif len(users) > 1 and (lead := discriminator(users)) is not None:
-                for u in users:  # replies: the one awaited, else by their leading constant
-                    body.append(f"            if (expect == {kind_name(ctx, u)}) {{")
-                    body.append(f"                {dec_call(ctx, u, values)}")
-                    body.append("            }")
-                body += leading_dispatch(ctx, lead, values)
-            elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
+            elif (apart := sized_apart(users, code is None and protocol.framing.by_request(d))) and (
+                lead := discriminator(users)
+            ) is not None:
+                body += leading_dispatch(ctx, lead, values)  # messages that share a code: by their leading constant
+            elif apart:  # requests (replies none of which is the default) that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
                     tests = [f"n >= {u.min_size}u"] if u.min_size else []
                     if u.max_size is not None and u.max_size <= 0xFFFFFFFF:

@@ -48,6 +48,7 @@ from serialspec.lang.model import (
     Text,
     discriminator,
     fixed_size,
+    sized_apart,
 )
 from serialspec.lang.names import mangled, python_name
 from serialspec.runtime.errors import SerialspecError
@@ -226,14 +227,27 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
 
 
 def shared_request_text(protocol: Protocol, message: Message) -> str:
-    """A request that shares its code with others (or, in frames without a command element, the frame with them):
-    picked by its leading constant (lang/model/discriminator.py), else told apart by its content size."""
-    if message.direction != Direction.REQUEST or message.subcommand is not None:
+    """A request that shares its code with others (or, in frames without a command element, the frame with them),
+    or a reply that does where none of them is the `default`: picked by its leading constant
+    (lang/model/discriminator.py), else told apart by its content size."""
+    if message.subcommand is not None or message.error_reply:
         return ""
-    code = protocol.command(message.command).code
-    sharing = [m for c in protocol.commands if c.code == code and (m := c.request) is not None and not c.selector]
+    direction = message.direction
+    command = protocol.command(message.command)
+    coded = protocol.layout(message).has_command
+    code = command.wire_code(direction) if coded else None
+    sharing = [
+        m
+        for c in protocol.commands
+        if (m := c.request if direction == Direction.REQUEST else c.response) is not None
+        and not c.selector
+        and not m.error_reply
+        and (c.wire_code(direction) if protocol.layout(m).has_command else None) == code
+    ]
     others = [m.command for m in sharing if m.command != message.command]
     if not others or not (isinstance(code, int) or code is None):
+        return ""
+    if not sized_apart(sharing, code is None and protocol.framing.by_request(direction)):
         return ""
     names = ", ".join(f"`{name}`" for name in others)
     shares = f"shares code {code:#04x} with {names}" if code is not None else f"sent without a code as {names} are"
@@ -345,8 +359,8 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
     sharing, asking = reply_sharing(protocol)
     if protocol.framing.by_command and protocol.framing.by_request(Direction.RESPONSE):
         return "read in the layout of the request it answers (decoding it needs that request)"
-    if sharing[code] < 2:
-        return ""
+    if sharing[code] < 2 or shared_request_text(protocol, message):
+        return ""  # alone, or told apart by its size (shared_request_text says so)
     askers = sorted(asking.get(message.key, ()))
     answers = ", ".join(f"`{a}`" for a in askers) or "no request"
     peers = [

@@ -476,6 +476,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         result_expr = ""
         cut = ""  # the part of a list the reply's value keeps: what the request asked
         statuses = status_fields(response) if response else []
+        alternatives = protocol.reply_alternatives(request)
         echoed: list[str] = []
         if response is not None:
             imports.add(response.class_name)
@@ -491,6 +492,10 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             echoed = [name for name in behaviour.echoes if name in {f.name for f in fields}] if behaviour else []
             if command.probe and not sub:
                 kind, returns = ("bool", "bool")
+            elif alternatives:  # replies that share its code, told apart by their size: whichever comes, whole
+                imports.update(m.class_name for m in alternatives)
+                kind, result_expr = "message", "reply"
+                returns = " | ".join(m.class_name for m in (response, *alternatives))
             elif not rest:
                 kind, returns = ("ack", "bool")
             elif len(rest) == 1 and isinstance(rest[0], List):
@@ -514,6 +519,12 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 doc.append("Returns: True once the device has answered; Timeout when it does not.")
             elif kind == "value":
                 doc.append(f"Returns: {rest[0].name}: {describe(rest[0])}")
+            elif alternatives:
+                others = ", ".join(m.class_name for m in alternatives)
+                doc.append(
+                    f"Returns: the {response.class_name} reply, or {others} (replies under its code, told apart by "
+                    "their size)."
+                )
             else:
                 doc.append(f"Returns: the {response.class_name} reply.")
             if silent:
@@ -744,20 +755,26 @@ def class_tuple(names: list[str]) -> str:
 
 def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
     """The Binding's replies of other commands: request class -> the reply classes of other commands that answer or
-    refuse it (`answered_by`, `refused_by`; the first only where replies are matched by command); reply class -> its
+    refuse it (`answered_by`, `refused_by`; the first only where replies are matched by command), or answer it
+    beside its own (`alternatives`: replies that share its code, told apart by their size); reply class -> its
     field holding the request's code (`request_code`), and the codes of the commands whose requests such replies
     answer."""
     answered: list[tuple[str, str]] = []
     refused: list[tuple[str, str]] = []
     code_fields: list[tuple[str, str]] = []
     codes: list[tuple[str, int]] = []
+    alternatives: list[tuple[str, str]] = []
     classes: list[str] = []  # the reply classes in either, which the module imports
     replies = replies_by_request(protocol.messages())
     for request, response in request_response_pairs(protocol):
         refusing = refusals_of(request, replies)
         refusals = [m.class_name for m in refusing]
         asked = [c.response for c in asked_commands(protocol) if c.response] if request.asks_in else []
-        others = [m.class_name for m in (response, *asked, *refusing) if m and m.command != request.command]
+        sized = protocol.reply_alternatives(request)
+        if sized:
+            alternatives.append((request.class_name, class_tuple([m.class_name for m in sized])))
+            classes += [m.class_name for m in sized]
+        others = [m.class_name for m in (response, *asked, *sized, *refusing) if m and m.command != request.command]
         if others and "command" in protocol.matching:  # only matching by command needs telling
             answered.append((request.class_name, class_tuple(others)))
             classes += others
@@ -773,6 +790,7 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
     return {
         "answered_by": answered,
         "refused_by": refused,
+        "alternatives": alternatives,
         "code_fields": code_fields,
         "codes": codes if code_fields else [],
         "classes": classes,

@@ -14,6 +14,7 @@ from serialspec.lang.model import (
     Message,
     Protocol,
     discriminator,
+    sized_apart,
     sizes_text,
     sizing_lead,
     sizing_message,
@@ -76,8 +77,8 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
 
 
 def size_dispatch(key: str, code: int | None, direction: Direction, messages: list[Message]) -> dict[str, Any]:
-    """Requests that share one code (`key` in the dispatch table, `code` the number or None for frames without
-    one), or replies picked by a leading constant: the decoder that picks one by that constant or else by the
+    """Requests (or replies none of which is the default) that share one code (`key` in the dispatch table, `code`
+    the number or None for frames without one): the decoder that picks one by their leading constant or else by the
     content size (the resolver checked that no size fits two), for the code's entry in the dispatch table."""
     code_name = "none" if code is None else f"{code:02x}"
     lead = discriminator(messages)
@@ -87,6 +88,7 @@ def size_dispatch(key: str, code: int | None, direction: Direction, messages: li
         "where": f"{direction.value} {key}" if code is not None else f"{direction.value} without a code",
         "sizes": ", ".join(f"{m.command}: {sizes_text(m)}" for m in messages),
         "lead": None,
+        "who": "Requests" if direction == Direction.REQUEST else "Replies",
     }
     if lead is not None:  # picked by their leading constant (lang/model/discriminator.py) rather than by size
         found["name"] = f"_decode_{direction.value}_{code_name}_by_{lead.name}"
@@ -107,15 +109,15 @@ def size_dispatch(key: str, code: int | None, direction: Direction, messages: li
 
 
 def shared_codes(protocol: Protocol, direction: Direction) -> set[int]:
-    """The codes several requests share (told apart by their content size); none in responses."""
-    if direction != Direction.REQUEST:
-        return set()
-    seen: set[int] = set()
-    shared: set[int] = set()
+    """The codes several messages of a direction share, told apart by their content size: requests' codes, and
+    replies' where none of those sharing it is the `default`."""
+    users: dict[int, list[Message]] = {}
     for command in protocol.commands:
-        if command.request is not None and command.code is not None:
-            (shared if command.code in seen else seen).add(command.code)
-    return shared
+        message = command.request if direction == Direction.REQUEST else command.response
+        code = command.wire_code(direction)
+        if message is not None and code is not None and not message.error_reply:
+            users.setdefault(code, []).append(message)
+    return {code for code, messages in users.items() if sized_apart(messages)}
 
 
 def code_key(command: Command, layout: FrameLayout) -> str:
@@ -169,13 +171,16 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         # the resolver allows several only for plain replies, one of them marked default, and for requests told
         # apart by their content size
         chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
-        shared = [m for m, _, _, _ in users if m is not None]
-        picked = direction == Direction.RESPONSE and len(shared) > 1 and discriminator(shared) is not None
-        if (direction == Direction.REQUEST or picked) and len(users) > 1:
-            # requests told apart by their leading constant or size; replies not awaited by their leading constant
-            by_size = size_dispatch(key, codes[key], direction, shared)
-            found.size_dispatchers.append(by_size | value_arguments(layout))
-            chosen = (None, by_size["name"], 0, None)
+        # requests, and replies none of which is the default (unless read in their request's layout), that share a
+        # code: told apart by their content size
+        messages = [m for m, _, _, _ in users if m is not None]
+        by_size = len(users) > 1 and sized_apart(
+            messages, codes[key] is None and protocol.framing.by_request(direction)
+        )
+        if by_size:
+            sized = size_dispatch(key, codes[key], direction, messages)
+            found.size_dispatchers.append(sized | value_arguments(layout))
+            chosen = (None, sized["name"], 0, None)
         found.dispatch.append((key, chosen[1]))
         highs = [u[3] for u in users]
         found.sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
@@ -185,6 +190,6 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         sizing = (sizing_message(messages) or sizing_lead(messages)) if len(messages) == len(users) else None
         if sizing is not None:
             found.sized[key] = sizing
-        if direction == Direction.RESPONSE:
+        if direction == Direction.RESPONSE and not by_size:
             found.expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
     return found

@@ -43,6 +43,7 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
     size_terms,
+    sized_apart,
 )
 from serialspec.runtime.framing import Layout
 
@@ -113,6 +114,19 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
     codes: dict[int | str, Any] = {}
     sharing: dict[int | str, list[Message]] = {}  # each key's messages, for a leading constant that picks them
     for command in protocol.commands:
+        message = command.request if direction == Direction.REQUEST else command.response
+        if message is not None and not (command.selector is not None and direction in command.selector.offsets):
+            key = _code(command.wire_code(direction) if coded else None)
+            if protocol.error_reply is not None and command.name == protocol.error_reply.command:
+                key = "error"
+            sharing.setdefault(key, []).append(message)
+    # requests that share a code, and replies none of which is the default: told apart by their content size
+    apart = {
+        key: sized_apart(found, key == "none" and protocol.framing.by_request(direction))
+        for key, found in sharing.items()
+    }
+    sharing = {}
+    for command in protocol.commands:
         selector = command.selector
         if selector is not None and direction in selector.offsets:
             subs = {}
@@ -137,7 +151,7 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
         sharing.setdefault(key, []).append(message)
-        if key in codes and direction == Direction.REQUEST:  # requests sharing a code: by their content size
+        if key in codes and apart.get(key):  # requests (replies without a default) sharing a code: by their size
             shared = codes[key]
             layouts_by_size = shared.get("by_size") or [shared.pop("message")]
             shared["by_size"] = [*layouts_by_size, _message(protocol, message)]
@@ -150,12 +164,6 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         codes[key] = {"message": _message(protocol, message)}
         codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
     for key, messages in sharing.items():
-        if direction == Direction.RESPONSE and key != "error" and discriminator(messages) is not None:
-            # replies that share a code (or carry none), picked by their leading constant: as such requests are
-            entries = [_message(protocol, m) for m in messages]
-            highs = [e["max"] for e in entries]
-            codes[key] = {"by_size": entries, "min": min(e["min"] for e in entries)}
-            codes[key]["max"] = None if None in highs else max(highs)
         lead = discriminator(messages) if "by_size" in codes[key] else None
         if lead is not None:  # picked by their leading constant (lang/model/discriminator.py), before their size
             if lead.size > 6:

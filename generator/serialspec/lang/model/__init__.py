@@ -35,6 +35,9 @@ from serialspec.lang.model.commands import (
     reply_to as reply_to,
 )
 from serialspec.lang.model.commands import (
+    sized_apart as sized_apart,
+)
+from serialspec.lang.model.commands import (
     sizes_text as sizes_text,
 )
 from serialspec.lang.model.device import (

@@ -72,6 +72,19 @@ def sizes_text(message: Message) -> str:
     return f"{low}..{high} bytes" if high is not None else f"{low} byte{'' if low == 1 else 's'} or more"
 
 
+def sized_apart(messages: Iterable[Message], by_request: bool = False) -> bool:
+    """Whether the messages that share a code (or, in frames without a command element, all of a direction's) are
+    told apart by their content size, or a leading constant (lang/model/discriminator.py): requests always; replies
+    when none of them is the `default` (the one decoded without its request, the others chosen by the request they
+    answer), unless they carry no code and are read in the layout of their request (`by_request`)."""
+    found = list(messages)
+    if len(found) < 2:
+        return False
+    if found[0].direction == Direction.REQUEST:
+        return True
+    return not by_request and not any(m.default_reply for m in found)
+
+
 def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
     """Responses by the request they answer: their own command's, or the one they say they `answers`."""
     index: dict[str, Message] = {}

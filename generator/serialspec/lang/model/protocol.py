@@ -6,12 +6,13 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.lang.frozen import frozen
-from serialspec.lang.model.commands import Command, Message
+from serialspec.lang.model.commands import Command, Message, replies_by_request, reply_to, sized_apart
 from serialspec.lang.model.device import Device
 from serialspec.lang.model.examples import Erratum, Example
 from serialspec.lang.model.fields import EnumDef, FlagsDef, Table
 from serialspec.lang.model.framing import ErrorReply, FrameLayout, Framing, Serial
 from serialspec.lang.model.text_frames import TextFrame
+from serialspec.runtime.message import Direction
 
 
 @frozen
@@ -47,6 +48,35 @@ class Protocol:
     @cached_property
     def _commands_by_name(self) -> dict[str, Command]:  # emitters look commands up per message
         return {c.name: c for c in self.commands}
+
+    def reply_alternatives(self, request: Message) -> tuple[Message, ...]:
+        """The replies that answer `request` besides its own (`reply_to`'s): the others that share its code, none of
+        them the `default`, told apart by their content size (sized_apart), and answer the same request
+        (`answers`). SPS30's
+        Read Measured Values: 40 bytes of floats, 20 of integers or none at all. A client returns whichever
+        comes."""
+        reply = reply_to(request, replies_by_request(self.messages()))
+        return self._sized_replies.get(reply.key, ()) if reply is not None else ()
+
+    @cached_property
+    def _sized_replies(self) -> dict[str, tuple[Message, ...]]:
+        groups: dict[int | None, list[Message]] = {}
+        for command in self.commands:
+            reply = command.response
+            if reply is None or reply.error_reply:
+                continue
+            code = command.wire_code(Direction.RESPONSE) if self.layout(reply).has_command else None
+            groups.setdefault(code, []).append(reply)
+        found: dict[str, tuple[Message, ...]] = {}
+        for code, group in groups.items():
+            if not sized_apart(group, code is None and self.framing.by_request(Direction.RESPONSE)):
+                continue
+            for reply in group:
+                asked = reply.answers or reply.key
+                others = [m for m in group if m is not reply and not m.unsolicited and (m.answers or m.key) == asked]
+                if others and not reply.unsolicited:
+                    found[reply.key] = tuple(others)
+        return found
 
     def layout(self, message: Message) -> FrameLayout:
         """The layout a message's frames travel in (its command's `layout`, else its direction's first; the error

@@ -30,7 +30,6 @@ from serialspec.lang.model import (
     leading_constant,
     replies_by_request,
     reply_to,
-    sized_by_itself,
     sizes_text,
     sizing_lead,
     sizing_message,
@@ -527,27 +526,36 @@ class Commands(FieldResolver):
                 if len(users) < 2 or (code is None and framing.by_request(direction)):
                     continue  # replies without a code read in the layout of their request: chosen by it
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
-                if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
+                by_size = direction == Direction.REQUEST or not any(m.default_reply for _, m in users)
+                if by_size and not any(c.selector for c, _ in users):
                     alike = [m for _, m in users]
                     if discriminator(alike) is not None and (sizing_lead(alike) or sizing_message(alike)):
                         # picked by a leading constant, each sized by its own bytes (Kondo ICS), or of one fixed
                         # size (iRobot's sensor queries): no length needed
                         continue
+                    kind = direction.value
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
                         shared = (
-                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
+                            f"{what} in {kind} frames is already used by {users[0][0].name!r}; {kind}s that share "
                             "a code"
                             if code is not None
-                            else f"{users[0][0].name!r} already sends requests without a code (the request frame has "
-                            "no command element); such requests"
+                            else f"{users[0][0].name!r} already sends {kind}s without a code (the {kind} frame has "
+                            f"no command element); such {kind}s"
+                        )
+                        other = (
+                            ""
+                            if direction == Direction.REQUEST
+                            else " (or mark one `default: true`: the reply a frame is decoded as when its request is "
+                            "unknown, the others chosen by the request they answer)"
                         )
                         reason = why_not_picked(alike)
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{shared} are told apart by their content size, which needs a length element{reason}",
+                            f"{shared} are told apart by their content size, which needs a length element{reason}"
+                            f"{other}",
                         )
                     elif discriminator([m for _, m in users]) is None:
-                        self.check_sizes_differ(what, users, code is not None)
+                        self.check_sizes_differ(what, users, code is not None, direction)
                     continue
                 if any(c.selector for c, _ in users):
                     for command, _ in users[1:]:
@@ -556,11 +564,6 @@ class Commands(FieldResolver):
                             f"{what} in {direction.value} frames is already used by {users[0][0].name!r}",
                         )
                     continue
-                replies = [m for _, m in users]
-                if discriminator(replies) is not None:
-                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
-                        self.check_self_sized(what, users)
-                    continue  # picked by their leading constant where the request is unknown (Kondo ICS)
                 defaults = [c.name for c, m in users if m.default_reply]
                 if len(defaults) != 1:
                     names = ", ".join(c.name for c, _ in users)
@@ -570,20 +573,12 @@ class Commands(FieldResolver):
                         "layout a reply is decoded as when its request is unknown)",
                     )
 
-    def check_self_sized(self, what: str, users: list[tuple[Command, Message]]) -> None:
-        """Replies picked by their leading constant in a frame without a length element: each must be sized by its
-        own bytes (a fixed size, a count at a fixed offset, a NUL), which then sizes the frame."""
-        for command, message in users:
-            if not sized_by_itself(message.fields):
-                self.error(
-                    ("commands", command.name, "response"),
-                    f"{what} is shared by replies picked by their leading constant, in a frame without a length "
-                    "element: each needs a size its own bytes tell (fixed fields, a count before the rest, or a "
-                    "NUL-terminated text last)",
-                )
-
-    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]], coded: bool) -> None:
-        """Requests that share a code are told apart by their content size: no size may fit two of them."""
+    def check_sizes_differ(
+        self, what: str, users: list[tuple[Command, Message]], coded: bool, direction: Direction
+    ) -> None:
+        """Requests (or replies none of which is the `default`) that share a code are told apart by their content
+        size: no size may fit two of them."""
+        kind = direction.value
         for index, (command, message) in enumerate(users):
             for other, earlier in users[:index]:
                 low = max(message.min_size, earlier.min_size)
@@ -591,11 +586,13 @@ class Commands(FieldResolver):
                 if not highs or low <= min(highs):
                     plural = "" if low == 1 else "s"
                     used = (
-                        f"{what} in request frames is already used by {other.name!r}"
+                        f"{what} in {kind} frames is already used by {other.name!r}"
                         if coded
-                        else f"{other.name!r} also sends requests without a code"
+                        else f"{other.name!r} also sends {kind}s without a code"
                     )
-                    apart = "requests that share a code" if coded else "requests without a code"
+                    apart = f"{kind}s that share a code" if coded else f"{kind}s without a code"
+                    if direction == Direction.RESPONSE:
+                        apart += ", none of them `default: true`,"
                     self.error(
                         ("commands", command.name),
                         f"{used}, and a content of {low} byte{plural} fits both ({apart} are told apart by their "

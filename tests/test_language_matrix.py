@@ -865,6 +865,22 @@ CASES["requests picked by a leading constant bit field, no command element"] = C
         },
     },
 )
+# One layout whose replies carry no code and differ in size, with nothing in the frame to size them (Pololu Maestro's
+# compact protocol written with `framing.elements`): each is read as the reply awaited (Framing.codeless_replies), in
+# Python and in C (p_parser_expect, p_decode_expect), the others' bytes garbage
+CASES["frame: one layout, code-less replies of different sizes, read as the reply awaited"] = Case(
+    {"v": "u16"},
+    {"w": "u16", "x": "u8"},
+    {
+        "elements": {
+            "code": {"role": "command", "type": "u8", "directions": ["request"]},
+            "content": {"role": "content"},
+        }
+    },
+    commands={
+        "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
+    },
+)
 # Messages picked by their leading constant in a frame with no command element and no length, each of its own size
 # (Kondo ICS: the command in a byte's top 3 bits, the servo id in its low 5; MIDI: a u4 status before a u4 channel
 # beside u8 system messages, a prefix code): requests and replies alike, each sized by its own bytes (fixed, or a
@@ -1426,7 +1442,16 @@ def codec_and_structs(g: Generated, message: Message) -> None:
         assert decoded.to_fields() == fields
         assert g.package.encode(cls.from_fields(json.loads(json.dumps(decoded.to_fields()))), *given_request) == frame
         check_against_construct(g, message, frame, fields, context)
-        if request is not None:  # without its request, such a reply is refused in one line
+        if request is not None and g.protocol.framing.codeless_replies:
+            # one layout's code-less replies: decoded alone as the default reply, or refused by its size
+            default = next(m for m in g.protocol.messages() if m.direction == message.direction and m.default_reply)
+            try:
+                alone = g.package.decode(frame, message.direction.value)
+            except DecodeError:
+                assert default.min_size != message.min_size
+            else:
+                assert type(alone).__name__ == default.class_name
+        elif request is not None:  # without its request, such a reply is refused in one line
             with pytest.raises(DecodeError, match="give the request"):
                 g.package.decode(frame, message.direction.value)
 
@@ -1456,13 +1481,15 @@ def stream_direction(g: Generated, direction: str) -> None:
             if e.role == "address"
             for v in range(int(e.minimum), int(e.maximum) + 1)
         }
-    if any(layout.elements[0].role == "content" for layout in g.protocol.framing.alternatives[Direction(direction)]):
-        # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
+    bare = any(layout.elements[0].role == "content" for layout in g.protocol.framing.alternatives[Direction(direction)])
+    if bare:  # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
         for message in g.protocol.messages():
             found = leading_constant(message)
             if found is not None and found[0][0] == 1:
                 (_, _, shift, bits), value = found
                 headers |= {b for b in range(256) if b >> shift & ((1 << bits) - 1) == value}
+            elif message.direction.value == direction:
+                headers |= set(range(256))  # any byte can begin one (Maestro's code-less replies): no garbage
     garbage = st.binary(max_size=6).map(lambda b: bytes(x for x in b if x not in headers))
     messages = [m for m in g.protocol.messages() if m.direction.value == direction]
     if g.protocol.framing.by_request(Direction(direction)):

@@ -232,8 +232,6 @@ def refuse_by_request(protocol: Protocol) -> None:
     """Unsupported for frames the C decoder cannot read alone. Layouts chosen by command (`layout:`) generate where
     every frame still says how to read it (a header, or a code sent in one layout alone)."""
     framing = protocol.framing
-    if framing.by_request(Direction.RESPONSE) and not framing.by_command:
-        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
     if framing.from_request and (framing.classic or any(layout.transparency for layout in every_layout(protocol))):
         raise Unsupported("a reply checksum over bytes of its request (`from_request`) in a classic or stuffed frame")
     if not framing.by_command:

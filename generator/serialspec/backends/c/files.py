@@ -1368,10 +1368,11 @@ static size_t {p}__least({p}_direction_t dir)
             return problem != {P}_OK ? problem : elsewhere != {P}_OK ? elsewhere : {P}_E_FRAME;
         }}
     }}"""
-        if asking.by_reply(protocol, Direction.RESPONSE):
-            # replies carry no code: the layout of the reply awaited (FrameCodec.unwrap with `replies`); the one
-            # layout where none is awaited and there is one
-            taking = f"""    if (dir == {P}_RESPONSE) {{
+    if asking.by_reply(protocol, Direction.RESPONSE):
+        # replies carry no code: the layout of the reply awaited (FrameCodec.unwrap with `replies`); the one
+        # layout where none is awaited and there is one
+        other = taking.lstrip() if chosen else "{\n" + taking + "\n    }"  # (a block either way)
+        taking = f"""    if (dir == {P}_RESPONSE) {{
         int at = {p}__reply_layout(expect);
         if (at < 0 && !(expect == {P}_KIND_NONE && count == 1u)) {{
             return {P}_E_ARG; /* no reply awaited, or a kind that is no reply */
@@ -1379,7 +1380,7 @@ static size_t {p}__least({p}_direction_t dir)
         k = at < 0 ? 0u : (uint8_t)at;
         r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
 {asking.refusal(ctx, f"{p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg})")}
-    }} else {taking.lstrip()}"""
+    }} else {other}"""
     admits_fn = optional.admits(ctx) if opt else ""
     unwrap_tail = "const uint8_t **content, size_t *clen"
     if asks:

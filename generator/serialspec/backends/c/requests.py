@@ -19,8 +19,9 @@ def asks(protocol: Protocol) -> bool:
 
 
 def by_reply(protocol: Protocol, direction: Direction) -> bool:
-    """The direction's frames carry no code: each is read in the layout of the reply awaited."""
-    return protocol.framing.by_command and protocol.framing.by_request(direction)
+    """The direction's frames carry no code: each is read in the layout of the reply awaited (layouts chosen by
+    command, or one layout's code-less replies that only the reply awaited sizes: Framing.by_request)."""
+    return protocol.framing.by_request(direction)
 
 
 def kind_name(ctx: Ctx, message: Message) -> str:

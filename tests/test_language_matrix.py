@@ -37,7 +37,15 @@ from serialspec.backends.python.memory import imported
 from serialspec.encodings import bit_run
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Direction, Message, Protocol, leading_constant, replies_by_request, reply_to
+from serialspec.lang.model import (
+    Bytes,
+    Direction,
+    Message,
+    Protocol,
+    leading_constant,
+    replies_by_request,
+    reply_to,
+)
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.errors import DecodeError
@@ -881,6 +889,16 @@ CASES["frame: one layout, code-less replies of different sizes, read as the repl
         "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
     },
 )
+# And a code-less reply whose last bytes are as many as its request asks for (the Pololu Tic's Get Variable, the
+# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`)
+CASES["frame: one layout, a code-less reply sized by its request (size_from)"] = Case(
+    {"offset": "u8", "length": {"type": "u8", "range": [1, 6]}},
+    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length"}},
+    {"elements": {"code": {"role": "command", "type": "u8", "directions": ["request"]}, "content": {"role": "content"}}},
+    commands={
+        "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
+    },
+)
 # Messages picked by their leading constant in a frame with no command element and no length, each of its own size
 # (Kondo ICS: the command in a byte's top 3 bits, the servo id in its low 5; MIDI: a u4 status before a u4 channel
 # beside u8 system messages, a prefix code): requests and replies alike, each sized by its own bytes (fixed, or a
@@ -1278,8 +1296,10 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
                 frames = []
                 for message in g.protocol.messages():
                     if message.direction == direction:
+                        request = asked(g, message)
                         for fields in st_examples(message_fields(g.protocol, message), 3):
-                            frames.append(agrees_with_python(run, g, message, fields))
+                            fields = fitted(message, fields, request)
+                            frames.append(agrees_with_python(run, g, message, fields, request))
                 stream_agrees_with_python(run, g, direction, b"\x00\x01".join(frames) + b"\x02", "1,3,0,7")
                 awaited_streams(run, g, direction)
                 for element in g.protocol.framing.layouts[direction].optional:
@@ -1307,7 +1327,7 @@ def awaited_streams(run: Any, g: Generated, direction: Direction) -> None:
             continue
         request = a_request(g, message)
         frames = [
-            agrees_with_python(run, g, message, fields, request)
+            agrees_with_python(run, g, message, fitted(message, fields, request), request)
             for fields in st_examples(message_fields(g.protocol, message), 2)
         ]
         stream = b"\x00".join(frames) + b"\x80" + frames[0][:-1]
@@ -1426,6 +1446,15 @@ def asked(g: Generated, message: Message) -> Any:
     return message_class(g, request).from_fields(st_examples(message_fields(g.protocol, request), 1)[0])
 
 
+def fitted(message: Message, fields: dict[str, Any], request: Any) -> dict[str, Any]:
+    """A reply's fields with its last bytes as many as its request asks for, where a field of the request says how
+    many (`size_from`: the encoder refuses another number where nothing else in the frame sizes them)."""
+    last = message.fields[-1] if message.fields else None
+    if request is None or not isinstance(last, Bytes) or not last.size_from:
+        return fields
+    return {**fields, last.name: " ".join(["5a"] * request.to_fields()[last.size_from])}
+
+
 def codec_and_structs(g: Generated, message: Message) -> None:
     cls = message_class(g, message)
     request = asked(g, message)
@@ -1437,6 +1466,7 @@ def codec_and_structs(g: Generated, message: Message) -> None:
     @SETTINGS
     @given(message_fields(g.protocol, message))
     def round_trip(fields: dict[str, Any]) -> None:
+        fields = fitted(message, fields, request)
         frame = g.package.encode(cls.from_fields(fields), *given_request)
         decoded = g.package.decode(frame, message.direction.value, cls, *given_request)
         assert decoded.to_fields() == fields
@@ -1481,7 +1511,10 @@ def stream_direction(g: Generated, direction: str) -> None:
             if e.role == "address"
             for v in range(int(e.minimum), int(e.maximum) + 1)
         }
-    bare = any(layout.elements[0].role == "content" for layout in g.protocol.framing.alternatives[Direction(direction)])
+    layouts = g.protocol.framing.alternatives[Direction(direction)]
+    if any(layout.elements[0].role == "command" for layout in layouts):  # no header: no byte a code can be
+        headers |= {c.wire_code(Direction(direction)) or 0 for c in g.protocol.commands if c.code is not None}
+    bare = any(layout.elements[0].role == "content" for layout in layouts)
     if bare:  # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
         for message in g.protocol.messages():
             found = leading_constant(message)
@@ -1525,6 +1558,7 @@ def replies_direction(g: Generated, message: Message, garbage: st.SearchStrategy
         st.data(),
     )
     def parse(drawn: list[dict[str, Any]], noise: list[bytes], data: st.DataObject) -> None:
+        drawn = [fitted(message, f, request) for f in drawn]
         frames = [g.package.encode(cls.from_fields(f), request) for f in drawn]
         wire = b"".join(noise[i % 5] + frame for i, frame in enumerate(frames)) + noise[-1]
         cuts = sorted(data.draw(st.lists(st.integers(0, len(wire)), max_size=6)))
@@ -1588,8 +1622,8 @@ def st_examples(strategy: st.SearchStrategy[Any], count: int) -> list[Any]:
 
 def cli_decode(g: Generated, spec: Path) -> None:
     for message in g.protocol.messages():
-        fields = st_examples(message_fields(g.protocol, message), 1)[0]
         request = asked(g, message)
+        fields = fitted(message, st_examples(message_fields(g.protocol, message), 1)[0], request)
         frame = g.package.encode(
             message_class(g, message).from_fields(fields), *(() if request is None else (request,))
         )

@@ -234,19 +234,20 @@ def refuse_by_request(protocol: Protocol) -> None:
     framing = protocol.framing
     if framing.from_request and (framing.classic or any(layout.transparency for layout in every_layout(protocol))):
         raise Unsupported("a reply checksum over bytes of its request (`from_request`) in a classic or stuffed frame")
-    if not framing.by_command:
-        return
     for message in protocol.messages():
         sized = message.fields[-1] if message.fields else None
         if (
             isinstance(sized, Bytes)
             and sized.size_from
             and framing.layout_of(message.direction, message.layout).length is None
+            and not framing.by_request(message.direction)
         ):
             raise Unsupported(  # the Python stream parser sizes it by the request awaited (runtime SizeRule.request)
-                "a reply sized by a field of its request in a frame without a length "
+                "a reply sized by a field of its request in a frame without a length, whose replies carry a code "
                 f"({message.class_name}: `size_from`)"
             )
+    if not framing.by_command:
+        return
     for direction, layouts in framing.alternatives.items():
         values = {tuple((e.name, e.type) for e in layout.value_elements) for layout in layouts}
         if len(values) > 1:

@@ -876,15 +876,13 @@ CASES["requests picked by a leading constant bit field, no command element"] = C
 # One layout whose replies carry no code and differ in size, with nothing in the frame to size them (Pololu Maestro's
 # compact protocol written with `framing.elements`): each is read as the reply awaited (Framing.codeless_replies), in
 # Python and in C (p_parser_expect, p_decode_expect), the others' bytes garbage
+CODELESS_REPLIES = {
+    "elements": {"code": {"role": "command", "type": "u8", "directions": ["request"]}, "content": {"role": "content"}}
+}
 CASES["frame: one layout, code-less replies of different sizes, read as the reply awaited"] = Case(
     {"v": "u16"},
     {"w": "u16", "x": "u8"},
-    {
-        "elements": {
-            "code": {"role": "command", "type": "u8", "directions": ["request"]},
-            "content": {"role": "content"},
-        }
-    },
+    CODELESS_REPLIES,
     commands={
         "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
     },
@@ -894,7 +892,7 @@ CASES["frame: one layout, code-less replies of different sizes, read as the repl
 CASES["frame: one layout, a code-less reply sized by its request (size_from)"] = Case(
     {"offset": "u8", "length": {"type": "u8", "range": [1, 6]}},
     {"data": {"type": "bytes", "size": "rest", "size_from": "request.length"}},
-    {"elements": {"code": {"role": "command", "type": "u8", "directions": ["request"]}, "content": {"role": "content"}}},
+    CODELESS_REPLIES,
     commands={
         "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
     },

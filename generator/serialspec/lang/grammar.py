@@ -593,7 +593,13 @@ MESSAGE = Obj(
         "fields": FIELDS,
         "text": TEXT_LAYOUT,
         "optional": TEXT,
-        "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
+        "unsolicited": Bool(
+            "Sent by the device on its own, not as an answer to its own command's request. It may still answer another "
+            "request, one that names it in `answered_by` or that it names in `answers` (a sensor's measurement, "
+            "streamed in active mode and sent when read in passive mode: PMS5003 `read: {request: {answered_by: "
+            "{command: data}}}`): the client's method for that request waits for it and returns it.",
+            default=False,
+        ),
         "values_only": Bool(
             "Text frames, a response: the reply is its values alone, without its code (ODrive's ASCII protocol "
             "answers `f 0` with `1.2340 0.5000`: `feedback: {code: f, request: {fields: {motor: integer}}, "

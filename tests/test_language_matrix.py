@@ -1010,6 +1010,35 @@ _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
 C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
 
+# Layouts chosen by command, `reply_code` on one layout's command element only (HLK-LD2410: ACKs under the command
+# word | 0x0100 beside reports whose u8 type byte is their own code): the other layout's commands keep their codes
+CASES["frame: layouts chosen by command, reply_code on one layout's command element"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "layouts": {
+            "command": {
+                "elements": {
+                    "header": {"role": "header", "value": "FD FC"},
+                    "length": {"role": "length", "type": "u16", "counts": ["word", "content"]},
+                    "word": {"role": "command", "type": "u16", "reply_code": "code | 0x0100"},
+                    "content": {"role": "content"},
+                }
+            },
+            "report": {
+                "elements": {
+                    "header": {"role": "header", "value": "F4 F3", "directions": ["response"]},
+                    "length": {"role": "length", "type": "u8", "counts": ["type", "content"]},
+                    "type": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "tail": {"role": "trailer", "value": "55"},
+                }
+            },
+        }
+    },
+    commands={"report": {"code": 2, "layout": "report", "response": {"unsolicited": True, "fields": {"d": "u16"}}}},
+)
+
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a
 # header, its code plain, tried last; one after a header, its code an expression of the command's (`code:`)

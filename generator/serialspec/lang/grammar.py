@@ -987,7 +987,11 @@ FRAME_ELEMENT = Obj(
             "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
             "`code | 0x40`, so STAT 0x07 is answered under 0x47). Every command's reply then has that code, computed "
             "when the spec is read: encode writes it, decode (without `--direction` too) and the stream parser read "
-            "a reply by it, the simulator answers with it and clients match replies as usual (by command).",
+            "a reply by it, the simulator answers with it and clients match replies as usual (by command). With "
+            "alternative layouts, every layout's command element gives the same one, unless layouts are chosen by "
+            "command (`layout:`): then only the commands whose replies travel in a layout that gives it have a reply "
+            "code (HLK-LD2410: ACKs under `code | 0x0100` in the command layout, beside reports whose type byte is "
+            "their own code in a report layout without it).",
             example="code | 0x40",
         ),
         "code": Str(

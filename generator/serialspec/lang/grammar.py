@@ -1296,7 +1296,8 @@ REPLY_VALUES = (
     "hex: VESC hw_name: '60'; a list for a list, array or group field: its numbers, or for a group one mapping of "
     "its fields per item, as u-blox MON-VER's extensions: `[{extension: FWVER=SPG 5.10}, {extension: "
     "PROTVER=34.10}]`). A `field.bit_field` key sets one bit field of every response that has the field (each "
-    "must have that bit field; its bit fields not named are 0)."
+    "must have that bit field; its bit fields not named are 0): a field made of bit fields takes its values so, "
+    "not as a whole number (SiRF's `mode1.position: 4`)."
 )
 _REPLY_ITEM_VALUE = OneOf((Num(), Str()), REPLY_VALUES)
 REPLY_VALUE = OneOf(

@@ -599,6 +599,15 @@ class DevicePass(Pass):
                 for shown, owner in owners:  # a reply value goes to every response that has the field
                     if bit and bit not in {b.name for b in getattr(owner, "bits", ())}:
                         self.error(at, f"{shown}'s {head} has no bit field {bit!r}")
+                    elif not bit and where == ("reply",) and isinstance(owner, Scalar) and owner.bits:
+                        bit_names = [b.name for b in owner.bits]
+                        # the simulator builds the value from its bit fields: a whole number is no value of it
+                        self.error(
+                            at,
+                            f"{shown}'s {head} is made of bit fields: give each as `{head}.{bit_names[0]}: ...` "
+                            f"(its bit fields: {', '.join(bit_names)})",
+                        )
+                        break
                     elif isinstance(given, list):
                         problem = list_problem(given, owner)
                         if problem:

@@ -15,7 +15,7 @@ from types import ModuleType
 
 import pytest
 import serial
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError
@@ -69,11 +69,8 @@ def test_replies_follow_the_peers_checksum(bms: ModuleType, voltages: list[int],
 
 @pytest.fixture
 def sim_path(bms: ModuleType) -> Iterator[str]:
-    simulator = importlib.import_module("jbd_bms.simulator").JbdBmsSimulator()
-    try:
-        yield simulator.start()
-    finally:
-        simulator.close()
+    with simulated("jbd_bms") as path:
+        yield path
 
 
 def test_the_peer_reads_and_drives_the_sim(sim_path: str) -> None:

@@ -19,7 +19,7 @@ from types import ModuleType
 from typing import Any
 
 import pytest
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -180,11 +180,8 @@ def test_the_reference_gives_each_layout_its_own_codes(tmp_path: Path) -> None:
 
 @pytest.fixture
 def sim_path(ld: ModuleType) -> Iterator[str]:
-    simulator = importlib.import_module("hlk_ld2410.simulator").HlkLd2410Simulator()
-    try:
-        yield simulator.start()
-    finally:
-        simulator.close()
+    with simulated("hlk_ld2410") as path:
+        yield path
 
 
 def test_the_generated_client_configures_the_sim(ld: ModuleType, sim_path: str) -> None:
@@ -203,14 +200,11 @@ def test_the_generated_client_configures_the_sim(ld: ModuleType, sim_path: str) 
 
 
 def test_the_c_reads_the_reports_and_acks(tmp_path: Path) -> None:
-    from test_c_backend import GCC, Driver
+    from test_c_backend import GCC, spec_driver
 
     if GCC is None:
         pytest.skip("no C compiler")
-    from serialspec.cli import main as serialspec_main
-
-    assert serialspec_main(["generate", str(SPEC), "--out", str(tmp_path), "--target", "c"]) == 0
-    driver = Driver("hlk_ld2410", tmp_path / "hlk_ld2410", tmp_path)
+    driver = spec_driver(SPEC, "hlk_ld2410", tmp_path)
     try:
         said = driver.ask("dec response f4f3f2f10d0002aa025100000000" + "3b0000" + "5500f8f7f6f5")[0]
         assert said.startswith("ok ") and json.loads(said[3:])["command"] == "basic_report"

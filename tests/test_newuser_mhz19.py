@@ -12,7 +12,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError
@@ -81,9 +81,7 @@ def test_the_peers_checksum_is_ours(mhz: ModuleType, co2: int, temperature: int,
 
 
 def test_the_peer_reads_the_sim(mhz: ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:
-    simulator = importlib.import_module("winsen_mhz19.simulator").WinsenMhz19Simulator()
-    path = simulator.start()
-    try:
+    with simulated("winsen_mhz19") as path:
         monkeypatch.setattr(mh_z19, "serial_dev", path)
         assert mh_z19.read_all(serial_console_untouched=True) == {
             "co2": 608,
@@ -96,5 +94,3 @@ def test_the_peer_reads_the_sim(mhz: ModuleType, monkeypatch: pytest.MonkeyPatch
         with client_module.WinsenMhz19Client(path, timeout=2) as client:
             reply = client.read_co2()
             assert (reply.co2, reply.temperature) == (608, 71)
-    finally:
-        simulator.close()

@@ -10,11 +10,12 @@ a bug, fixed."""
 from __future__ import annotations
 
 import importlib
+from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -99,11 +100,9 @@ def test_a_frame_with_a_wrong_sum_is_refused(pms: ModuleType) -> None:
 
 
 @pytest.fixture
-def sim(pms: ModuleType) -> object:
-    simulator = importlib.import_module("pms5003.simulator").Pms5003Simulator()
-    path = simulator.start()
-    yield path
-    simulator.close()
+def sim(pms: ModuleType) -> Iterator[str]:
+    with simulated("pms5003") as path:
+        yield path
 
 
 def test_the_peer_drives_the_sim(sim: str) -> None:

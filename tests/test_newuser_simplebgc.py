@@ -14,7 +14,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError
@@ -72,11 +72,8 @@ def test_the_stream_parser_reads_replies_among_noise(bgc: ModuleType) -> None:
 
 @pytest.fixture
 def sim_path(bgc: ModuleType) -> Iterator[str]:
-    simulator = importlib.import_module("simplebgc.simulator").SimplebgcSimulator()
-    try:
-        yield simulator.start()
-    finally:
-        simulator.close()
+    with simulated("simplebgc") as path:
+        yield path
 
 
 def test_the_generated_client_against_the_sim(bgc: ModuleType, sim_path: str) -> None:
@@ -90,14 +87,11 @@ def test_the_generated_client_against_the_sim(bgc: ModuleType, sim_path: str) ->
 
 
 def test_the_c_reads_both_checksums(tmp_path: Path) -> None:
-    from test_c_backend import GCC, Driver
+    from test_c_backend import GCC, spec_driver
 
     if GCC is None:
         pytest.skip("no C compiler")
-    from serialspec.cli import main as serialspec_main
-
-    assert serialspec_main(["generate", str(SPEC), "--out", str(tmp_path), "--target", "c"]) == 0
-    driver = Driver("simplebgc", tmp_path / "simplebgc", tmp_path)
+    driver = spec_driver(SPEC, "simplebgc", tmp_path)
     try:
         said = driver.ask("dec request 3e430d5002000000000000550500000000" + "5c")[0]
         assert said.startswith("ok ") and json.loads(said[3:])["fields"]["angle_pitch"] == 1365

@@ -15,7 +15,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import examples, generate_and_import
+from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError, EncodeError
@@ -103,11 +103,8 @@ def test_a_whole_number_for_bit_fields_in_reply_is_one_line(tmp_path: Path) -> N
 
 @pytest.fixture
 def sim_path(sirf: ModuleType) -> Iterator[str]:
-    simulator = importlib.import_module("sirf_binary.simulator").SirfBinarySimulator()
-    try:
-        yield simulator.start()
-    finally:
-        simulator.close()
+    with simulated("sirf_binary") as path:
+        yield path
 
 
 def test_the_generated_client_against_the_sim(sirf: ModuleType, sim_path: str) -> None:
@@ -120,14 +117,11 @@ def test_the_generated_client_against_the_sim(sirf: ModuleType, sim_path: str) -
 
 
 def test_the_c_reads_the_manuals_messages(tmp_path: Path) -> None:
-    from test_c_backend import GCC, Driver
+    from test_c_backend import GCC, spec_driver
 
     if GCC is None:
         pytest.skip("no C compiler")
-    from serialspec.cli import main as serialspec_main
-
-    assert serialspec_main(["generate", str(SPEC), "--out", str(tmp_path), "--target", "c"]) == 0
-    driver = Driver("sirf_binary", tmp_path / "sirf_binary", tmp_path)
+    driver = spec_driver(SPEC, "sirf_binary", tmp_path)
     try:
         said = driver.ask("dec request a0a20009860000258008010000" + "0134b0b3")[0]
         assert said.startswith("ok ") and json.loads(said[3:])["fields"]["bit_rate"] == 9600

@@ -124,5 +124,6 @@ def test_the_generated_client_polls_the_sim_in_passive_mode(pms: ModuleType, sim
         assert (streamed.pm2_5_cf1, streamed.particles_0_3) == (12, 1500)
         client.change_mode(pms.Mode.PASSIVE)
         reply = client.read()  # was None: the request was sent and the reply it is answered by never awaited
+        assert "Args:" not in (client_module.Pms5003Client.read.__doc__ or "")  # an empty section once
         assert isinstance(reply, pms.DataResponse)
         assert [getattr(reply, name) for name in WORDS[:3]] == [8, 12, 15]

@@ -1010,6 +1010,20 @@ _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
 C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
 
+# A length counting the whole frame, from the header before it (Benewake TFmini Plus: 5A, the frame's length, ...)
+CASES["frame: a length counting from the header before it"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "z": "i16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "length": {"role": "length", "type": "u8", "counts": ["header", "checksum"]},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["header", "content"]},
+        }
+    },
+)
 # Layouts chosen by command, `reply_code` on one layout's command element only (HLK-LD2410: ACKs under the command
 # word | 0x0100 beside reports whose u8 type byte is their own code): the other layout's commands keep their codes
 CASES["frame: layouts chosen by command, reply_code on one layout's command element"] = Case(

@@ -1005,7 +1005,9 @@ FRAME_ELEMENT = Obj(
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
             "it the bytes as sent); default the content only. It may start at the length itself (LX-16A: "
-            "`counts: [length, checksum]`, N parameters + 3), which counts its own bytes too.",
+            "`counts: [length, checksum]`, N parameters + 3), which counts its own bytes too, or at an element of "
+            "fixed size before it, outside a transparency span (Benewake TFmini Plus: `counts: [head, checksum]`, "
+            "the whole frame from its header), which counts those too.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,

@@ -138,6 +138,15 @@ CASES: dict[str, Case] = {
     "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
     "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
     "bytes, size field of u64": same({"n": "u64", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    # len() of bytes and of a fixed array in a value (JBD's password size: `value: len(password)`): C's `_len`, a count
+    "value: len() of bytes and of a fixed array": same(
+        {
+            "n": {"type": "u8", "value": "len(data)"},
+            "data": {"type": "bytes", "size": "n"},
+            "k": {"type": "u8", "value": "len(fixed) + 1"},
+            "fixed": {"type": "array", "of": "u8", "count": 3},
+        }
+    ),
     "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),

@@ -97,3 +97,42 @@ def test_the_generated_client_reads_the_sim(bms: ModuleType, sim_path: str) -> N
         assert (info.total_voltage, info.rsoc, list(info.temperatures)) == (5888, 72, [2934, 2946])
         assert info.production_date.year == 16
         assert client.hardware_version() == "JBD-SP15S020"
+
+
+def test_the_c_measures_the_password_by_its_bytes(tmp_path: Path) -> None:
+    """`size: {value: len(password)}` of bytes: the C said `m->password_count` (no such member: `password_len`) and
+    did not compile."""
+    import json
+
+    from test_c_backend import GCC, spec_driver
+
+    if GCC is None:
+        pytest.skip("no C compiler")
+    driver = spec_driver(SPEC, "jbd_bms", tmp_path)
+    try:
+        frame = peer().writeCmd(0x06, [6, *b"J1B2D4"]).hex()  # type: ignore[attr-defined]
+        said = driver.ask(f"dec request {frame}")[0]
+        assert said.startswith("ok ") and json.loads(said[3:])["fields"]["password"] == "4a 31 42 32 44 34"
+    finally:
+        driver.close()
+
+
+def test_len_of_text_in_a_value_is_one_line(tmp_path: Path) -> None:
+    """Python's len() of text counts characters, the frame its UTF-8 bytes: `value: len(name)` with a text sized by it
+    encoded `µm` as 2 followed by 3 bytes, a frame that did not decode. Refused now, naming the form that works."""
+    from serialspec.lang import SpecErrors, load_protocol
+
+    text = SPEC.read_text("utf-8").replace(
+        "        name: {type: string, size: rest}",
+        '        size: {type: u8, value: "len(name)"}\n        name: {type: string, size: size}',
+    )
+    spec = tmp_path / "jbd.yaml"
+    spec.write_text(text, "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "jbd.yaml")
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].endswith(
+        "commands.hardware_version.response.fields.size.value: len(name): name is text, whose characters are not its "
+        "bytes; size it by a field (`size: size`), which encode then writes"
+    )

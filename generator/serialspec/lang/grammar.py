@@ -485,7 +485,8 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
     "value": Str(
         "An integer field derived from the others by an expression, computed on encode and checked on decode: "
-        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>). "
+        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len() of a list, group or bytes (not of text, "
+        "whose characters are not its bytes), ceil(a / b), min, max, + - * / % & | << >>). "
         "At most 500 characters and 50 levels deep; every value it can take for any values of its fields' types "
         "(intermediate ones too) within 512 bits, and some value within the field's range (a constant one must fit "
         "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded, in "

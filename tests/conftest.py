@@ -352,3 +352,16 @@ def simulated(package: str) -> Iterator[str]:
         yield simulator.start()
     finally:
         simulator.close()
+
+
+def spec_error(text: str, folder: Path) -> str:
+    """The one line the loader refuses a spec's text with (written to FOLDER/spec.yaml): a test asserts its end."""
+    from serialspec.lang import SpecErrors
+
+    spec = folder / "spec.yaml"
+    spec.write_text(text, "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "spec.yaml")
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]

@@ -15,7 +15,7 @@ from types import ModuleType
 
 import pytest
 import serial
-from conftest import examples, generate_and_import, simulated
+from conftest import examples, generate_and_import, simulated, spec_error
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError
@@ -120,19 +120,11 @@ def test_the_c_measures_the_password_by_its_bytes(tmp_path: Path) -> None:
 def test_len_of_text_in_a_value_is_one_line(tmp_path: Path) -> None:
     """Python's len() of text counts characters, the frame its UTF-8 bytes: `value: len(name)` with a text sized by it
     encoded `µm` as 2 followed by 3 bytes, a frame that did not decode. Refused now, naming the form that works."""
-    from serialspec.lang import SpecErrors, load_protocol
-
     text = SPEC.read_text("utf-8").replace(
         "        name: {type: string, size: rest}",
         '        size: {type: u8, value: "len(name)"}\n        name: {type: string, size: size}',
     )
-    spec = tmp_path / "jbd.yaml"
-    spec.write_text(text, "utf-8")
-    with pytest.raises(SpecErrors) as caught:
-        load_protocol(str(spec), "jbd.yaml")
-    lines = str(caught.value).splitlines()
-    assert len(lines) == 1, lines
-    assert lines[0].endswith(
+    assert spec_error(text, tmp_path).endswith(
         "commands.hardware_version.response.fields.size.value: len(name): name is text, whose characters are not its "
         "bytes; size it by a field (`size: size`), which encode then writes"
     )

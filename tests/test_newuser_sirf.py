@@ -15,7 +15,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from conftest import examples, generate_and_import, simulated
+from conftest import examples, generate_and_import, simulated, spec_error
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError, EncodeError
@@ -87,15 +87,8 @@ def test_the_stream_parser_splits_messages_anywhere(sirf: ModuleType) -> None:
 
 
 def test_a_whole_number_for_bit_fields_in_reply_is_one_line(tmp_path: Path) -> None:
-    from serialspec.lang import SpecErrors, load_protocol
-
-    spec = tmp_path / "sirf.yaml"
-    spec.write_text(SPEC.read_text("utf-8").replace("mode1.position: 4,", "mode1: 4,"), "utf-8")
-    with pytest.raises(SpecErrors) as caught:
-        load_protocol(str(spec), "sirf.yaml")
-    lines = str(caught.value).splitlines()
-    assert len(lines) == 1, lines
-    assert lines[0].endswith(
+    text = SPEC.read_text("utf-8").replace("mode1.position: 4,", "mode1: 4,")
+    assert spec_error(text, tmp_path).endswith(
         "device.reply.mode1: the measured_navigation response's mode1 is made of bit fields: give each as "
         "`mode1.dgps: ...` (its bit fields: dgps, dop_mask, altitude, trickle, position)"
     )

@@ -146,6 +146,15 @@ CASES: dict[str, Case] = {
     "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
     "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
     "bytes, size field of u64": same({"n": "u64", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    # len() of bytes and of a fixed array in a value (JBD's password size: `value: len(password)`): C's `_len`, a count
+    "value: len() of bytes and of a fixed array": same(
+        {
+            "n": {"type": "u8", "value": "len(data)"},
+            "data": {"type": "bytes", "size": "n"},
+            "k": {"type": "u8", "value": "len(fixed) + 1"},
+            "fixed": {"type": "array", "of": "u8", "count": 3},
+        }
+    ),
     "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),
@@ -1081,6 +1090,49 @@ _data["seq"] = {"role": "value", "type": "u8", "range": [0, 99]}
 _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
 C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
+
+# A length counting the whole frame, from the header before it (Benewake TFmini Plus: 5A, the frame's length, ...)
+CASES["frame: a length counting from the header before it"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "z": "i16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "length": {"role": "length", "type": "u8", "counts": ["header", "checksum"]},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["header", "content"]},
+        }
+    },
+)
+# Layouts chosen by command, `reply_code` on one layout's command element only (HLK-LD2410: ACKs under the command
+# word | 0x0100 beside reports whose u8 type byte is their own code): the other layout's commands keep their codes
+CASES["frame: layouts chosen by command, reply_code on one layout's command element"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "layouts": {
+            "command": {
+                "elements": {
+                    "header": {"role": "header", "value": "FD FC"},
+                    "length": {"role": "length", "type": "u16", "counts": ["word", "content"]},
+                    "word": {"role": "command", "type": "u16", "reply_code": "code | 0x0100"},
+                    "content": {"role": "content"},
+                }
+            },
+            "report": {
+                "elements": {
+                    "header": {"role": "header", "value": "F4 F3", "directions": ["response"]},
+                    "length": {"role": "length", "type": "u8", "counts": ["type", "content"]},
+                    "type": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "tail": {"role": "trailer", "value": "55"},
+                }
+            },
+        }
+    },
+    commands={"report": {"code": 2, "layout": "report", "response": {"unsolicited": True, "fields": {"d": "u16"}}}},
+)
 
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a

@@ -864,6 +864,23 @@ def refuse_wide_values(protocol: Protocol) -> None:
                     )
 
 
+def c_length(fields: tuple[Field, ...], target: str) -> Callable[[str], str]:
+    """`len(field)` of a value expression in C: a list's or group's item count, the bytes of bytes, a fixed array's
+    count (the language refuses it of text)."""
+    by_name = {f.name: f for f in fields}
+
+    def length(name: str) -> str:
+        match by_name.get(name):
+            case Bytes(size=int() as size) | Array(count=size) | Packed(count=size) | Group(count=int() as size):
+                return str(size)
+            case Bytes():
+                return f"{target}{ident(name)}_len"
+            case _:
+                return f"{target}{ident(name)}_count"
+
+    return length
+
+
 def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str], math: CMath) -> str:
     """An expression of the spec in C, over int64_t: `name(field)` and `length(list)` give the operands. It computes
     exactly what Python computes (refuse_wide_values has ruled out any value beyond int64_t, no_value a division by
@@ -957,7 +974,7 @@ def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]
                 test = f"{value} < {low}"
             lines.append(f"    if ({test}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: out of its range */")
         if isinstance(f, Scalar) and f.value is not None:
-            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            length = c_length(fields, scope.target)
             math = math_of(ctx, fields)
             computed = render_c(f.value, scope.lookup, length, math)
             for condition in no_value(f.value, scope.lookup, length, math):
@@ -1337,7 +1354,7 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
     for f in fields:
         if isinstance(f, Scalar) and f.value is not None:
             local = f"v1_{ident(f.name)}"
-            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            length = c_length(fields, scope.target)
             math = math_of(ctx, fields)
             computed = render_c(f.value, scope.lookup, length, math)
             for condition in no_value(f.value, scope.lookup, length, math):  # a division by a 0 given: refused

@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -334,3 +335,33 @@ def generate_and_import(spec: Path, out: Path, name: str) -> ModuleType:
         return importlib.import_module(name)
     finally:
         sys.path.remove(str(out))
+
+
+@contextmanager
+def simulated(package: str) -> Iterator[str]:
+    """The generated simulator of `package` (a protocol package already imported, e.g. by generate_and_import) serving
+    its default devices on a pseudo-terminal in this process: its path, while the block runs."""
+    module = importlib.import_module(f"{package}.simulator")
+    simulator_class = next(
+        value
+        for name, value in vars(module).items()
+        if name.endswith("Simulator") and value.__module__ == module.__name__
+    )
+    simulator = simulator_class()
+    try:
+        yield simulator.start()
+    finally:
+        simulator.close()
+
+
+def spec_error(text: str, folder: Path) -> str:
+    """The one line the loader refuses a spec's text with (written to FOLDER/spec.yaml): a test asserts its end."""
+    from serialspec.lang import SpecErrors
+
+    spec = folder / "spec.yaml"
+    spec.write_text(text, "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(str(spec), "spec.yaml")
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]

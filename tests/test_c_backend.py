@@ -333,6 +333,14 @@ def driver(name: str, command: tuple[str, ...] = (), build: str = "gcc") -> Driv
     return Driver(name, GENERATED_C / name, scratch_folder("serialspec-c-"), command, build)
 
 
+def spec_driver(spec: Path, name: str, folder: Path) -> Driver:
+    """The driver of a spec of a test's own (its C generated into `folder`), for a test that decodes a few frames."""
+    from serialspec.cli import main as serialspec_main
+
+    assert serialspec_main(["generate", str(spec), "--out", str(folder), "--target", "c"]) == 0
+    return Driver(name, folder / name, folder)
+
+
 @cache
 def spec_buffer_driver(name: str) -> Driver:
     """The driver with the spec's own P_MAX_FRAME (the buffer a firmware has: the parser moves the bytes it holds to

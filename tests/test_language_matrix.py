@@ -37,7 +37,15 @@ from serialspec.backends.python.memory import imported
 from serialspec.encodings import bit_run
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Direction, Message, Protocol, leading_constant, replies_by_request, reply_to
+from serialspec.lang.model import (
+    Bytes,
+    Direction,
+    Message,
+    Protocol,
+    leading_constant,
+    replies_by_request,
+    reply_to,
+)
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.errors import DecodeError
@@ -138,6 +146,15 @@ CASES: dict[str, Case] = {
     "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
     "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
     "bytes, size field of u64": same({"n": "u64", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    # len() of bytes and of a fixed array in a value (JBD's password size: `value: len(password)`): C's `_len`, a count
+    "value: len() of bytes and of a fixed array": same(
+        {
+            "n": {"type": "u8", "value": "len(data)"},
+            "data": {"type": "bytes", "size": "n"},
+            "k": {"type": "u8", "value": "len(fixed) + 1"},
+            "fixed": {"type": "array", "of": "u8", "count": 3},
+        }
+    ),
     "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),
@@ -865,6 +882,30 @@ CASES["requests picked by a leading constant bit field, no command element"] = C
         },
     },
 )
+# One layout whose replies carry no code and differ in size, with nothing in the frame to size them (Pololu Maestro's
+# compact protocol written with `framing.elements`): each is read as the reply awaited (Framing.codeless_replies), in
+# Python and in C (p_parser_expect, p_decode_expect), the others' bytes garbage
+CODELESS_REPLIES = {
+    "elements": {"code": {"role": "command", "type": "u8", "directions": ["request"]}, "content": {"role": "content"}}
+}
+CASES["frame: one layout, code-less replies of different sizes, read as the reply awaited"] = Case(
+    {"v": "u16"},
+    {"w": "u16", "x": "u8"},
+    CODELESS_REPLIES,
+    commands={
+        "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
+    },
+)
+# And a code-less reply whose last bytes are as many as its request asks for (the Pololu Tic's Get Variable, the
+# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`)
+CASES["frame: one layout, a code-less reply sized by its request (size_from)"] = Case(
+    {"offset": "u8", "length": {"type": "u8", "range": [1, 6]}},
+    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length"}},
+    CODELESS_REPLIES,
+    commands={
+        "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}
+    },
+)
 # Messages picked by their leading constant in a frame with no command element and no length, each of its own size
 # (Kondo ICS: the command in a byte's top 3 bits, the servo id in its low 5; MIDI: a u4 status before a u4 channel
 # beside u8 system messages, a prefix code): requests and replies alike, each sized by its own bytes (fixed, or a
@@ -1049,6 +1090,49 @@ _data["seq"] = {"role": "value", "type": "u8", "range": [0, 99]}
 _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
 C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
+
+# A length counting the whole frame, from the header before it (Benewake TFmini Plus: 5A, the frame's length, ...)
+CASES["frame: a length counting from the header before it"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "z": "i16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "length": {"role": "length", "type": "u8", "counts": ["header", "checksum"]},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["header", "content"]},
+        }
+    },
+)
+# Layouts chosen by command, `reply_code` on one layout's command element only (HLK-LD2410: ACKs under the command
+# word | 0x0100 beside reports whose u8 type byte is their own code): the other layout's commands keep their codes
+CASES["frame: layouts chosen by command, reply_code on one layout's command element"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "layouts": {
+            "command": {
+                "elements": {
+                    "header": {"role": "header", "value": "FD FC"},
+                    "length": {"role": "length", "type": "u16", "counts": ["word", "content"]},
+                    "word": {"role": "command", "type": "u16", "reply_code": "code | 0x0100"},
+                    "content": {"role": "content"},
+                }
+            },
+            "report": {
+                "elements": {
+                    "header": {"role": "header", "value": "F4 F3", "directions": ["response"]},
+                    "length": {"role": "length", "type": "u8", "counts": ["type", "content"]},
+                    "type": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "tail": {"role": "trailer", "value": "55"},
+                }
+            },
+        }
+    },
+    commands={"report": {"code": 2, "layout": "report", "response": {"unsolicited": True, "fields": {"d": "u16"}}}},
+)
 
 
 # The same commands in two frame forms (the Pololu Maestro's compact and Pololu protocols): one layout without a
@@ -1262,8 +1346,10 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
                 frames = []
                 for message in g.protocol.messages():
                     if message.direction == direction:
+                        request = asked(g, message)
                         for fields in st_examples(message_fields(g.protocol, message), 3):
-                            frames.append(agrees_with_python(run, g, message, fields))
+                            fields = fitted(message, fields, request)
+                            frames.append(agrees_with_python(run, g, message, fields, request))
                 stream_agrees_with_python(run, g, direction, b"\x00\x01".join(frames) + b"\x02", "1,3,0,7")
                 awaited_streams(run, g, direction)
                 for element in g.protocol.framing.layouts[direction].optional:
@@ -1291,7 +1377,7 @@ def awaited_streams(run: Any, g: Generated, direction: Direction) -> None:
             continue
         request = a_request(g, message)
         frames = [
-            agrees_with_python(run, g, message, fields, request)
+            agrees_with_python(run, g, message, fitted(message, fields, request), request)
             for fields in st_examples(message_fields(g.protocol, message), 2)
         ]
         stream = b"\x00".join(frames) + b"\x80" + frames[0][:-1]
@@ -1410,6 +1496,15 @@ def asked(g: Generated, message: Message) -> Any:
     return message_class(g, request).from_fields(st_examples(message_fields(g.protocol, request), 1)[0])
 
 
+def fitted(message: Message, fields: dict[str, Any], request: Any) -> dict[str, Any]:
+    """A reply's fields with its last bytes as many as its request asks for, where a field of the request says how
+    many (`size_from`: the encoder refuses another number where nothing else in the frame sizes them)."""
+    last = message.fields[-1] if message.fields else None
+    if request is None or not isinstance(last, Bytes) or not last.size_from:
+        return fields
+    return {**fields, last.name: " ".join(["5a"] * request.to_fields()[last.size_from])}
+
+
 def codec_and_structs(g: Generated, message: Message) -> None:
     cls = message_class(g, message)
     request = asked(g, message)
@@ -1421,12 +1516,22 @@ def codec_and_structs(g: Generated, message: Message) -> None:
     @SETTINGS
     @given(message_fields(g.protocol, message))
     def round_trip(fields: dict[str, Any]) -> None:
+        fields = fitted(message, fields, request)
         frame = g.package.encode(cls.from_fields(fields), *given_request)
         decoded = g.package.decode(frame, message.direction.value, cls, *given_request)
         assert decoded.to_fields() == fields
         assert g.package.encode(cls.from_fields(json.loads(json.dumps(decoded.to_fields()))), *given_request) == frame
         check_against_construct(g, message, frame, fields, context)
-        if request is not None:  # without its request, such a reply is refused in one line
+        if request is not None and g.protocol.framing.codeless_replies:
+            # one layout's code-less replies: decoded alone as the default reply, or refused by its size
+            default = next(m for m in g.protocol.messages() if m.direction == message.direction and m.default_reply)
+            try:
+                alone = g.package.decode(frame, message.direction.value)
+            except DecodeError:
+                assert default.min_size != message.min_size
+            else:
+                assert type(alone).__name__ == default.class_name
+        elif request is not None:  # without its request, such a reply is refused in one line
             with pytest.raises(DecodeError, match="give the request"):
                 g.package.decode(frame, message.direction.value)
 
@@ -1456,13 +1561,18 @@ def stream_direction(g: Generated, direction: str) -> None:
             if e.role == "address"
             for v in range(int(e.minimum), int(e.maximum) + 1)
         }
-    if any(layout.elements[0].role == "content" for layout in g.protocol.framing.alternatives[Direction(direction)]):
-        # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
+    layouts = g.protocol.framing.alternatives[Direction(direction)]
+    if any(layout.elements[0].role == "command" for layout in layouts):  # no header: no byte a code can be
+        headers |= {c.wire_code(Direction(direction)) or 0 for c in g.protocol.commands if c.code is not None}
+    bare = any(layout.elements[0].role == "content" for layout in layouts)
+    if bare:  # no header, no command element: no byte a message's leading constant can begin with (Kondo ICS)
         for message in g.protocol.messages():
             found = leading_constant(message)
             if found is not None and found[0][0] == 1:
                 (_, _, shift, bits), value = found
                 headers |= {b for b in range(256) if b >> shift & ((1 << bits) - 1) == value}
+            elif message.direction.value == direction:
+                headers |= set(range(256))  # any byte can begin one (Maestro's code-less replies): no garbage
     garbage = st.binary(max_size=6).map(lambda b: bytes(x for x in b if x not in headers))
     messages = [m for m in g.protocol.messages() if m.direction.value == direction]
     if g.protocol.framing.by_request(Direction(direction)):
@@ -1498,6 +1608,7 @@ def replies_direction(g: Generated, message: Message, garbage: st.SearchStrategy
         st.data(),
     )
     def parse(drawn: list[dict[str, Any]], noise: list[bytes], data: st.DataObject) -> None:
+        drawn = [fitted(message, f, request) for f in drawn]
         frames = [g.package.encode(cls.from_fields(f), request) for f in drawn]
         wire = b"".join(noise[i % 5] + frame for i, frame in enumerate(frames)) + noise[-1]
         cuts = sorted(data.draw(st.lists(st.integers(0, len(wire)), max_size=6)))
@@ -1561,8 +1672,8 @@ def st_examples(strategy: st.SearchStrategy[Any], count: int) -> list[Any]:
 
 def cli_decode(g: Generated, spec: Path) -> None:
     for message in g.protocol.messages():
-        fields = st_examples(message_fields(g.protocol, message), 1)[0]
         request = asked(g, message)
+        fields = fitted(message, st_examples(message_fields(g.protocol, message), 1)[0], request)
         frame = g.package.encode(
             message_class(g, message).from_fields(fields), *(() if request is None else (request,))
         )

@@ -263,6 +263,8 @@ def test_a_pin_in_the_command_byte(tmp_path: Path) -> None:
     message = module.decode(bytes.fromhex("e3 7f 07"), module.Direction.REQUEST)
     assert message == module.AnalogMessageRequest(pin=3, value=1023)
     assert module.encode(module.ReportAnalogRequest(pin=5, enable=1)) == bytes.fromhex("c5 01")
+    with pytest.raises(DecodeError, match=r"unknown kind 0xa0 .* nor a response \(the protocol has no response "):
+        module.decode(bytes.fromhex("a0 00 00"))  # (it said "unknown command None" of the responses)
     stream = bytes.fromhex("f9 c5 01 e3 7f 07 f9")
     parser = module.StreamParser(module.Direction.REQUEST)
     found = [m for byte in stream for m in parser.feed(bytes([byte]))]

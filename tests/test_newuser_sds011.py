@@ -117,3 +117,30 @@ def test_mixed_byte_orders_in_a_group_item(tmp_path: Path) -> None:
     message = mixed.decode(frame, mixed.Direction.REQUEST)
     assert [(p.x, p.y) for p in message.points] == [(0x1234, 0x1234), (0x5678, 0x5678)]
     assert mixed.encode(message) == frame
+
+
+def test_the_client_awaits_the_report_a_query_is_answered_by(nova: ModuleType) -> None:
+    """The report is sent on its own (`unsolicited`) and `answers: query_data`: the client's query_data() sent the
+    query and returned None, never waiting for the report that answers it."""
+    import importlib
+    import os
+    import threading
+    import tty
+
+    report = bytes.fromhex("AA C0 D4 04 3A 0A A1 60 1D AB")
+    controller, device = os.openpty()
+    tty.setraw(device)
+
+    def sensor() -> None:
+        os.read(controller, 64)  # the query
+        os.write(controller, report)
+
+    try:
+        with importlib.import_module("nova_sds011.client").NovaSds011Client(os.ttyname(device), timeout=2) as client:
+            thread = threading.Thread(target=sensor, daemon=True)
+            thread.start()
+            assert client.query_data(bytes(12)) == nova.ReportResponse(pm25=1236, pm10=2618, device_id=0xA160)
+            thread.join()
+    finally:
+        os.close(controller)
+        os.close(device)

@@ -174,3 +174,52 @@ def test_the_configuration_commands_beside_the_data_frames(tmp_path: Path) -> No
             tf.ConfigModeResponse,
             tf.MeasurementResponse,
         ], size
+
+
+PLUS = """protocol: tfmini_plus
+title: Benewake TFmini Plus commands
+byte_order: little
+serial: {baudrate: 115200}
+framing:
+  elements:
+    head: {role: header, value: 5A}
+    len: {role: length, type: u8, counts: [head, checksum], description: The whole frame's length.}
+    id: {role: command, type: u8}
+    payload: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [head, payload]}
+commands:
+  version:
+    code: 0x01
+    request: {}
+    response: {fields: {patch: u8, minor: u8, major: u8}}
+  frame_rate:
+    code: 0x03
+    request: {fields: {rate: u16}}
+    response: {fields: {rate: u16}}
+examples:
+  version:
+    source: TFmini Plus product manual, obtain firmware version
+    direction: request
+    printed: 5A 04 01 5F
+    command: version
+    fields: {}
+  rate:
+    source: TFmini Plus product manual, frame rate 100 Hz
+    direction: request
+    printed: 5A 06 03 64 00 C7
+    command: frame_rate
+    fields: {rate: 100}
+"""
+
+
+def test_a_length_counting_the_whole_frame_from_its_header(tmp_path: Path) -> None:
+    """The TFmini Plus's commands give the whole frame's length after the 5A header (`counts: [head, checksum]`): it
+    was refused (`the length must come before what it counts`), though a length counting itself was taken."""
+    spec = tmp_path / "tfmini_plus.yaml"
+    spec.write_text(PLUS, "utf-8")
+    plus = generate_and_import(spec, tmp_path / "out", "tfmini_plus")
+    assert plus.encode(plus.FrameRateRequest(rate=100)) == bytes.fromhex("5A 06 03 64 00 C7")
+    reply = plus.encode(plus.VersionResponse(patch=3, minor=1, major=2))
+    assert reply == bytes.fromhex("5A 07 01 03 01 02 68")
+    parser = plus.StreamParser(plus.Direction.RESPONSE)
+    assert parser.feed(reply[2:] + reply + reply[:3]) == [plus.VersionResponse(patch=3, minor=1, major=2)]

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "b8d48b01cec37652cb102a93eb32a9e4d3b081e0b6ad82fea3197523fec7e49a"
+#define NMEA0183_SPEC_SHA256 "0d68d097da764938ad683e8624b5773698de66e03b46bfe9250cc2f562c13ac5"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -580,7 +580,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     try:
         decoder = _RESPONSE_DECODERS[None]
     except KeyError:
-        raise DecodeError("unknown command None") from None
+        raise DecodeError("the protocol has no response without a code") from None
     if expect is not None:
         expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
         if alternative is not None and expected is None:
@@ -690,7 +690,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         try:
             decoder = _RESPONSE_DECODERS[None]
         except KeyError:
-            raise DecodeError("unknown command None") from None
+            raise DecodeError("the protocol has no response without a code") from None
         if expect is not None:
             expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
             if alternative is not None and expected is None:

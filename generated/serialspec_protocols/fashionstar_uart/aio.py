@@ -389,8 +389,6 @@ class AsyncFashionstarUartClient(AsyncClientBase):
 
         Every servo on the bus holds the move commands it gets from now on until END_ASYNC, which runs them all at once (or drops them). The content is empty: it addresses every servo.
 
-        Args:
-
         The device does not answer.
         """
         request = BeginAsyncRequest()

@@ -19,7 +19,7 @@ local SPEC = {
   digits = 2,
   talker = 2,
   required = false,
-  checksum = {algorithm = "xor", invert = false},
+  checksum = {algorithm = "xor", invert = false, little = false},
   messages = {
     GGA = {
       response = {
@@ -185,9 +185,14 @@ local CHECKSUMS = {}
 CHECKSUMS["xor"] = function(spec, size, data)
   local total = 0
   for i = 1, #data, size do
-    local word = 0
+    local word, place = 0, 1
     for j = i, i + size - 1 do
-      word = word * 256 + (data:byte(j) or 0)
+      if spec.little then
+        word = word + (data:byte(j) or 0) * place
+        place = place * 256
+      else
+        word = word * 256 + (data:byte(j) or 0)
+      end
     end
     total = bxor(total, word)
   end

@@ -80,8 +80,6 @@ class AsyncUbxClient(AsyncClientBase):
 
         The fix status, time to first fix and time since startup; polled with an empty payload.
 
-        Args:
-
         Returns: the NavStatusResponse reply.
         """
         request = NavStatusRequest()
@@ -93,8 +91,6 @@ class AsyncUbxClient(AsyncClientBase):
 
         The navigation solution: time, fix, position, velocity, accuracy and DOP in one 92-byte message, sent once per navigation solution when enabled (the simulated receiver sends it every second) and polled with an empty payload.
 
-        Args:
-
         Returns: the NavPvtResponse reply.
         """
         request = NavPvtRequest()
@@ -105,8 +101,6 @@ class AsyncUbxClient(AsyncClientBase):
         """CFG-RATE, navigation and measurement rate (poll).
 
         Polls the measurement and navigation rate (an empty payload); the receiver answers with CFG-RATE and its settings. Setting them is set_rate, the same class and id with a 6-byte payload.
-
-        Args:
 
         Returns: the CfgRateResponse reply.
         """
@@ -168,8 +162,6 @@ class AsyncUbxClient(AsyncClientBase):
         """MON-VER, receiver and software version.
 
         The receiver's software and hardware versions and its extensions (firmware, protocol, module, GNSS); polled with an empty payload.
-
-        Args:
 
         Returns: the MonVerResponse reply.
         """

@@ -123,8 +123,6 @@ class UbxClient(ClientBase):
 
         The fix status, time to first fix and time since startup; polled with an empty payload.
 
-        Args:
-
         Returns: the NavStatusResponse reply.
         """
         request = NavStatusRequest()
@@ -136,8 +134,6 @@ class UbxClient(ClientBase):
 
         The navigation solution: time, fix, position, velocity, accuracy and DOP in one 92-byte message, sent once per navigation solution when enabled (the simulated receiver sends it every second) and polled with an empty payload.
 
-        Args:
-
         Returns: the NavPvtResponse reply.
         """
         request = NavPvtRequest()
@@ -148,8 +144,6 @@ class UbxClient(ClientBase):
         """CFG-RATE, navigation and measurement rate (poll).
 
         Polls the measurement and navigation rate (an empty payload); the receiver answers with CFG-RATE and its settings. Setting them is set_rate, the same class and id with a 6-byte payload.
-
-        Args:
 
         Returns: the CfgRateResponse reply.
         """
@@ -211,8 +205,6 @@ class UbxClient(ClientBase):
         """MON-VER, receiver and software version.
 
         The receiver's software and hardware versions and its extensions (firmware, protocol, module, GNSS); polled with an empty payload.
-
-        Args:
 
         Returns: the MonVerResponse reply.
         """

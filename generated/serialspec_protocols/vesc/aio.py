@@ -77,8 +77,6 @@ class AsyncVescClient(AsyncClientBase):
 
         Asks for the firmware version and the hardware.
 
-        Args:
-
         Returns: the FwVersionResponse reply.
         """
         request = FwVersionRequest()
@@ -89,8 +87,6 @@ class AsyncVescClient(AsyncClientBase):
         """COMM_GET_VALUES.
 
         Asks for the present values of the motor controller.
-
-        Args:
 
         Returns: the GetValuesResponse reply.
         """
@@ -180,8 +176,6 @@ class AsyncVescClient(AsyncClientBase):
         """COMM_ALIVE.
 
         Keeps the present command in force (resets the timeout) without changing it.
-
-        Args:
 
         The device does not answer.
         """

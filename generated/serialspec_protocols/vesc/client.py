@@ -96,8 +96,6 @@ class VescClient(ClientBase):
 
         Asks for the firmware version and the hardware.
 
-        Args:
-
         Returns: the FwVersionResponse reply.
         """
         request = FwVersionRequest()
@@ -108,8 +106,6 @@ class VescClient(ClientBase):
         """COMM_GET_VALUES.
 
         Asks for the present values of the motor controller.
-
-        Args:
 
         Returns: the GetValuesResponse reply.
         """
@@ -199,8 +195,6 @@ class VescClient(ClientBase):
         """COMM_ALIVE.
 
         Keeps the present command in force (resets the timeout) without changing it.
-
-        Args:
 
         The device does not answer.
         """

@@ -180,6 +180,22 @@ def names(expr: Expr) -> Iterator[str]:
             yield from names(arg)
 
 
+def with_lengths(expr: Expr, lengths: Mapping[str, int]) -> Expr:
+    """The expression with `len(field)` of the fields whose length is known (a fixed array's count, fixed bytes'
+    size) replaced by that number: a decoder that reads such a field in a run of fixed fields has no list of it."""
+    if isinstance(expr, Length) and expr.name in lengths:
+        return Const(lengths[expr.name])
+    if isinstance(expr, BinOp):
+        return BinOp(expr.op, with_lengths(expr.left, lengths), with_lengths(expr.right, lengths))
+    if isinstance(expr, Invert):
+        return Invert(with_lengths(expr.operand, lengths))
+    if isinstance(expr, Ceil):
+        return Ceil(with_lengths(expr.numerator, lengths), with_lengths(expr.denominator, lengths))
+    if isinstance(expr, MinMax):
+        return MinMax(expr.function, tuple(with_lengths(arg, lengths) for arg in expr.args))
+    return expr
+
+
 def render(expr: Expr, name: Callable[[str], str]) -> str:
     """Python source for the expression; `name(field)` gives the source of a field's value. Integer arithmetic
     only: `/` is `//`, ceil(a / b) is -(-a // b)."""

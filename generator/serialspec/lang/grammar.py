@@ -485,7 +485,8 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
     "value": Str(
         "An integer field derived from the others by an expression, computed on encode and checked on decode: "
-        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>). "
+        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len() of a list, group or bytes (not of text, "
+        "whose characters are not its bytes), ceil(a / b), min, max, + - * / % & | << >>). "
         "At most 500 characters and 50 levels deep; every value it can take for any values of its fields' types "
         "(intermediate ones too) within 512 bits, and some value within the field's range (a constant one must fit "
         "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded, in "
@@ -593,7 +594,13 @@ MESSAGE = Obj(
         "fields": FIELDS,
         "text": TEXT_LAYOUT,
         "optional": TEXT,
-        "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
+        "unsolicited": Bool(
+            "Sent by the device on its own, not as an answer to its own command's request. It may still answer another "
+            "request, one that names it in `answered_by` or that it names in `answers` (a sensor's measurement, "
+            "streamed in active mode and sent when read in passive mode: PMS5003 `read: {request: {answered_by: "
+            "{command: data}}}`): the client's method for that request waits for it and returns it.",
+            default=False,
+        ),
         "values_only": Bool(
             "Text frames, a response: the reply is its values alone, without its code (ODrive's ASCII protocol "
             "answers `f 0` with `1.2340 0.5000`: `feedback: {code: f, request: {fields: {motor: integer}}, "
@@ -1058,7 +1065,11 @@ FRAME_ELEMENT = Obj(
             "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
             "`code | 0x40`, so STAT 0x07 is answered under 0x47). Every command's reply then has that code, computed "
             "when the spec is read: encode writes it, decode (without `--direction` too) and the stream parser read "
-            "a reply by it, the simulator answers with it and clients match replies as usual (by command).",
+            "a reply by it, the simulator answers with it and clients match replies as usual (by command). With "
+            "alternative layouts, every layout's command element gives the same one, unless layouts are chosen by "
+            "command (`layout:`): then only the commands whose replies travel in a layout that gives it have a reply "
+            "code (HLK-LD2410: ACKs under `code | 0x0100` in the command layout, beside reports whose type byte is "
+            "their own code in a report layout without it).",
             example="code | 0x40",
         ),
         "code": Str(
@@ -1072,7 +1083,9 @@ FRAME_ELEMENT = Obj(
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
             "it the bytes as sent); default the content only. It may start at the length itself (LX-16A: "
-            "`counts: [length, checksum]`, N parameters + 3), which counts its own bytes too.",
+            "`counts: [length, checksum]`, N parameters + 3), which counts its own bytes too, or at an element of "
+            "fixed size before it, outside a transparency span (Benewake TFmini Plus: `counts: [head, checksum]`, "
+            "the whole frame from its header), which counts those too.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
@@ -1363,7 +1376,8 @@ REPLY_VALUES = (
     "hex: VESC hw_name: '60'; a list for a list, array or group field: its numbers, or for a group one mapping of "
     "its fields per item, as u-blox MON-VER's extensions: `[{extension: FWVER=SPG 5.10}, {extension: "
     "PROTVER=34.10}]`). A `field.bit_field` key sets one bit field of every response that has the field (each "
-    "must have that bit field; its bit fields not named are 0)."
+    "must have that bit field; its bit fields not named are 0): a field made of bit fields takes its values so, "
+    "not as a whole number (SiRF's `mode1.position: 4`)."
 )
 _REPLY_ITEM_VALUE = OneOf((Num(), Str()), REPLY_VALUES)
 REPLY_VALUE = OneOf(

@@ -232,23 +232,22 @@ def refuse_by_request(protocol: Protocol) -> None:
     """Unsupported for frames the C decoder cannot read alone. Layouts chosen by command (`layout:`) generate where
     every frame still says how to read it (a header, or a code sent in one layout alone)."""
     framing = protocol.framing
-    if framing.by_request(Direction.RESPONSE) and not framing.by_command:
-        raise Unsupported("code-less replies of different sizes that only the request sizes (no length element)")
     if framing.from_request and (framing.classic or any(layout.transparency for layout in every_layout(protocol))):
         raise Unsupported("a reply checksum over bytes of its request (`from_request`) in a classic or stuffed frame")
-    if not framing.by_command:
-        return
     for message in protocol.messages():
         sized = message.fields[-1] if message.fields else None
         if (
             isinstance(sized, Bytes)
             and sized.size_from
             and framing.layout_of(message.direction, message.layout).length is None
+            and not framing.by_request(message.direction)
         ):
             raise Unsupported(  # the Python stream parser sizes it by the request awaited (runtime SizeRule.request)
-                "a reply sized by a field of its request in a frame without a length "
+                "a reply sized by a field of its request in a frame without a length, whose replies carry a code "
                 f"({message.class_name}: `size_from`)"
             )
+    if not framing.by_command:
+        return
     for direction, layouts in framing.alternatives.items():
         values = {tuple((e.name, e.type) for e in layout.value_elements) for layout in layouts}
         if len(values) > 1:
@@ -865,6 +864,23 @@ def refuse_wide_values(protocol: Protocol) -> None:
                     )
 
 
+def c_length(fields: tuple[Field, ...], target: str) -> Callable[[str], str]:
+    """`len(field)` of a value expression in C: a list's or group's item count, the bytes of bytes, a fixed array's
+    count (the language refuses it of text)."""
+    by_name = {f.name: f for f in fields}
+
+    def length(name: str) -> str:
+        match by_name.get(name):
+            case Bytes(size=int() as size) | Array(count=size) | Packed(count=size) | Group(count=int() as size):
+                return str(size)
+            case Bytes():
+                return f"{target}{ident(name)}_len"
+            case _:
+                return f"{target}{ident(name)}_count"
+
+    return length
+
+
 def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str], math: CMath) -> str:
     """An expression of the spec in C, over int64_t: `name(field)` and `length(list)` give the operands. It computes
     exactly what Python computes (refuse_wide_values has ruled out any value beyond int64_t, no_value a division by
@@ -958,7 +974,7 @@ def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]
                 test = f"{value} < {low}"
             lines.append(f"    if ({test}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: out of its range */")
         if isinstance(f, Scalar) and f.value is not None:
-            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            length = c_length(fields, scope.target)
             math = math_of(ctx, fields)
             computed = render_c(f.value, scope.lookup, length, math)
             for condition in no_value(f.value, scope.lookup, length, math):
@@ -1338,7 +1354,7 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
     for f in fields:
         if isinstance(f, Scalar) and f.value is not None:
             local = f"v1_{ident(f.name)}"
-            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            length = c_length(fields, scope.target)
             math = math_of(ctx, fields)
             computed = render_c(f.value, scope.lookup, length, math)
             for condition in no_value(f.value, scope.lookup, length, math):  # a division by a 0 given: refused

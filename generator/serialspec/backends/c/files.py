@@ -603,10 +603,11 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     error = ctx.protocol.error_reply
     flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
     wanted = asking.by_reply(ctx.protocol, direction)  # no code: sized as the reply awaited (`want`, its kind)
+    asked = asking.asked_replies(ctx.protocol)  # (a reply sized by its request: `asked`, the request's field)
     lines = [
         f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: probe, straight line. */",
         f"static long {p}__probe_{direction.value}_{k}(const uint8_t *f, size_t avail"
-        + (", long want)" if wanted else ")"),
+        + ((", long want, long asked)" if asked else ", long want)") if wanted else ")"),
         "{",
         "    size_t low = 0u, high = 0u;",
         "    int bounded = 0;",
@@ -672,6 +673,19 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
             "    code = want;",
             f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}",
         ]
+        for reply, _, field, fixed in asked:
+            if kind_name(ctx, reply) in kinds:  # sized by its request's field (runtime SizeRule.request)
+                lines += [
+                    f"    if (want == {kind_name(ctx, reply)}) {{ /* size_from request.{field} */",
+                    f"        long content = asked < 0 ? -1L : {fixed}L + asked;",
+                    "        if (content < (long)low || (bounded && content > (long)high)) {",
+                    f"            return {P}__NONE;",
+                    "        }",
+                    f"        return {sum(sizes)}L + content;",
+                    "    }",
+                ]
+        if asked:
+            lines.append("    (void)asked;")
     elif command < 0:
         lines.append(
             f"    if (!{p}__bounds({P}_{direction.name}, {P}__NO_CODE, &low, &high, &bounded)) {{ return {P}__NONE; }}"
@@ -955,6 +969,12 @@ def source(ctx: Ctx) -> str:
     want_param, want_void, want_arg = ("", "", "")
     if wanting:
         want_param, want_void, want_arg = (", long want", "\n    (void)want;", ", (long)p->expect")
+    if asking.asked_replies(protocol):  # and the size the request asks of its reply (`size_from`)
+        want_param, want_void, want_arg = (
+            want_param + ", long asked",
+            want_void + "\n    (void)asked;",
+            want_arg + ", p->asked",
+        )
     asks = asking.asks(protocol)
     pre_param, pre_arg = (", const uint8_t *pre, size_t pre_n", ", pre, pre_n") if asks else ("", "")
     msgs = messages(protocol)
@@ -1008,6 +1028,7 @@ def source(ctx: Ctx) -> str:
                 if "__unwrap_" in probes[-1]:  # ended by its trailer: the probe calls the unwrap defined below
                     terminated.append((d, k))
                 want = ", want" if asking.by_reply(protocol, d) else ""
+                want += ", asked" if want and asking.asked_replies(protocol) else ""
                 prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail{want});")
         # each direction's headers as a table by layout (NULL, 0: none); k is below the direction's count
         heads = [f"{p}__h_{d.value}_{k}" if layout.header else "NULL" for k, layout in enumerate(alternatives)]
@@ -1368,10 +1389,11 @@ static size_t {p}__least({p}_direction_t dir)
             return problem != {P}_OK ? problem : elsewhere != {P}_OK ? elsewhere : {P}_E_FRAME;
         }}
     }}"""
-        if asking.by_reply(protocol, Direction.RESPONSE):
-            # replies carry no code: the layout of the reply awaited (FrameCodec.unwrap with `replies`); the one
-            # layout where none is awaited and there is one
-            taking = f"""    if (dir == {P}_RESPONSE) {{
+    if asking.by_reply(protocol, Direction.RESPONSE):
+        # replies carry no code: the layout of the reply awaited (FrameCodec.unwrap with `replies`); the one
+        # layout where none is awaited and there is one
+        other = taking.lstrip() if chosen else "{\n" + taking + "\n    }"  # (a block either way)
+        taking = f"""    if (dir == {P}_RESPONSE) {{
         int at = {p}__reply_layout(expect);
         if (at < 0 && !(expect == {P}_KIND_NONE && count == 1u)) {{
             return {P}_E_ARG; /* no reply awaited, or a kind that is no reply */
@@ -1379,7 +1401,7 @@ static size_t {p}__least({p}_direction_t dir)
         k = at < 0 ? 0u : (uint8_t)at;
         r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
 {asking.refusal(ctx, f"{p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg})")}
-    }} else {taking.lstrip()}"""
+    }} else {other}"""
     admits_fn = optional.admits(ctx) if opt else ""
     unwrap_tail = "const uint8_t **content, size_t *clen"
     if asks:
@@ -1725,7 +1747,9 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     expect_function = parser_api.expect_function(p, P, classic)
     if asks:  # p_parser_expect awaits a reply without its request (Python's expect(cls): request None)
         expect_function = expect_function.replace(
-            "    parser->expect = reply;\n", "    parser->expect = reply;\n    parser->has_request = 0u;\n"
+            "    parser->expect = reply;\n",
+            "    parser->expect = reply;\n    parser->has_request = 0u;\n"
+            + ("    parser->asked = -1L;\n" if asking.asked_replies(protocol) else ""),
         )
         assert "has_request" in expect_function
         expect_function += asking.expect_reply(ctx)

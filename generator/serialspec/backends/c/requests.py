@@ -10,7 +10,7 @@ from serialspec.backends import Unsupported
 from serialspec.backends.c.emit import Ctx, ident, messages, msg_id
 from serialspec.backends.common.frames import layout_index
 from serialspec.backends.common.pairing import layout_refusals
-from serialspec.lang.model import VALUE_ROLES, Direction, Message, Protocol
+from serialspec.lang.model import VALUE_ROLES, Bytes, Direction, Message, Protocol, fixed_size
 
 
 def asks(protocol: Protocol) -> bool:
@@ -18,9 +18,29 @@ def asks(protocol: Protocol) -> bool:
     return protocol.framing.from_request or protocol.framing.by_request(Direction.RESPONSE)
 
 
+def asked_replies(protocol: Protocol) -> list[tuple[Message, Message, str, int]]:
+    """Replies whose last bytes are as many as a field of their request says (`size_from`) in a layout without a
+    length, read as the reply awaited: (reply, its request, the request's field, the reply's bytes before them). The
+    parser keeps that field's value (`asked`, from p_parser_expect_reply) to size them (runtime SizeRule.request)."""
+    found = []
+    for reply in protocol.messages():
+        *before, last = reply.fields or (None,)
+        if reply.direction != Direction.RESPONSE or not isinstance(last, Bytes) or not last.size_from:
+            continue
+        if protocol.layout(reply).length is not None or not by_reply(protocol, Direction.RESPONSE):
+            continue
+        request = next(
+            m for m in protocol.messages() if m.direction == Direction.REQUEST and reply_of(protocol, m) is reply
+        )
+        fixed = sum(fixed_size(f) or 0 for f in before)
+        found.append((reply, request, last.size_from, fixed))
+    return found
+
+
 def by_reply(protocol: Protocol, direction: Direction) -> bool:
-    """The direction's frames carry no code: each is read in the layout of the reply awaited."""
-    return protocol.framing.by_command and protocol.framing.by_request(direction)
+    """The direction's frames carry no code: each is read in the layout of the reply awaited (layouts chosen by
+    command, or one layout's code-less replies that only the reply awaited sizes: Framing.by_request)."""
+    return protocol.framing.by_request(direction)
 
 
 def kind_name(ctx: Ctx, message: Message) -> str:
@@ -192,10 +212,15 @@ void {p}_parser_expect_reply({p}_parser_t *parser, const {p}_msg_t *request);
 
 def parser_members(ctx: Ctx) -> str:
     P = ctx.P
+    asked = (
+        "    long asked; /* the size the request awaited asks of its reply (`size_from`; -1: none) */\n"
+        if asked_replies(ctx.protocol)
+        else ""
+    )
     return (
         f"    uint8_t request[{P}_REQUEST_BYTES];    /* the request replies answer ({ctx.p}_parser_expect_reply) */\n"
         "    size_t request_len;\n"
-        "    uint8_t has_request;\n"
+        "    uint8_t has_request;\n" + asked
     )
 
 
@@ -260,6 +285,26 @@ void {p}_parser_expect_reply({p}_parser_t *parser, const {p}_msg_t *request)
     int has = {p}__request_bytes(request, parser->request, &n, &reply);
     {p}_parser_expect(parser, reply);
     parser->has_request = (uint8_t)has;
-    parser->request_len = n;
+    parser->request_len = n;{asked_lines(ctx)}
 }}
 """
+
+
+def asked_lines(ctx: Ctx) -> str:
+    """p_parser_expect_reply's lines keeping the request's field that sizes its reply (asked_replies)."""
+    found = asked_replies(ctx.protocol)
+    if not found:
+        return ""
+    cases = "".join(
+        f"\n    case {kind_name(ctx, request)}:\n        parser->asked = (long)request->u.{msg_id(request)}."
+        f"{ident(field.removeprefix('request.'))}; /* {reply.key}: size_from request.{field} */\n        break;"
+        for reply, request, field, _ in found
+    )
+    return f"""
+    if (request == NULL) {{
+        return;
+    }}
+    switch (request->kind) {{{cases}
+    default:
+        break;
+    }}"""

@@ -483,6 +483,23 @@ def frame_picture(protocol: Protocol) -> list[str]:
     ]
 
 
+def reply_coded(protocol: Protocol, layout: FrameLayout) -> bool:
+    """Whether a response layout's command element carries the requests' codes as `reply_code` computes them: every
+    layout's, unless layouts are chosen by command and none of this one's commands has a reply code (HLK-LD2410's
+    reports beside its ACKs)."""
+    framing = protocol.framing
+    if not framing.reply_code:
+        return False
+    if not framing.by_command:
+        return True
+    return any(
+        c.response_code is not None
+        and c.response is not None
+        and framing.layout_of(Direction.RESPONSE, c.response.layout) == layout
+        for c in protocol.commands
+    )
+
+
 def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
     rows = []
     offset = 0
@@ -503,7 +520,7 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             asked = " and ".join(f"`{name}`" for name in e.checksum.from_request)
             after = f"the request's {asked} (bytes it answers), then " if asked else ""
             description = f"over {after}`{e.checksum.first}`..`{e.checksum.last}`{skips}{endian}. {e.description}"
-        elif e.role == "command" and layout.direction == Direction.RESPONSE and protocol.framing.reply_code:
+        elif e.role == "command" and layout.direction == Direction.RESPONSE and reply_coded(protocol, layout):
             computed = f"the code of the request it answers, as `{protocol.framing.reply_code}`"
             description = ". ".join(p for p in (computed, e.description) if p)
         elif e.role == "command" and e.code:

@@ -452,14 +452,14 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         if command.broadcast:
             doc.append("")
             doc.append("Broadcast: " + one_line(command.broadcast))
-        doc.append("")
-        doc.append("Args:")
-        doc.extend(f"    {f.name}: {describe(f)}" for f in fields if f.name not in sequences)
-        doc.extend(
+        args = [f"    {f.name}: {describe(f)}" for f in fields if f.name not in sequences]
+        args += [
             f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
             for p in pairs
-        )
-        doc.extend(f"    ({p['name']} also takes a plain sequence of {p['field']} values.)" for p in singles)
+        ]
+        args += [f"    ({p['name']} also takes a plain sequence of {p['field']} values.)" for p in singles]
+        if args:  # a method without arguments has no Args section (it had an empty one)
+            doc += ["", "Args:", *args]
         # An address that can hold the broadcast value makes the reply optional, unless the device answers it anyway.
         may_broadcast = not (behaviour and behaviour.broadcast_reply) and any(
             f.name == address and isinstance(f, Scalar) and broadcast is not None and f.maximum >= broadcast

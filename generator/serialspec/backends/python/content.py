@@ -96,6 +96,16 @@ _STRUCT_NAMES = {
 }
 
 
+def fixed_lengths(fields: list[SpecField]) -> dict[str, int]:
+    """What `len()` of each field of a known length is: a fixed array's or packed array's count, fixed bytes' size."""
+    found: dict[str, int] = {}
+    for f in fields:
+        match f:
+            case Array(count=count) | Packed(count=count) | Bytes(size=int() as count):
+                found[f.name] = count
+    return found
+
+
 def bound(f: Scalar, value: float) -> str:
     """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
     as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
@@ -564,7 +574,10 @@ class PackageCode:
                 if f.value in (scaled, items if listed.item.size == 1 else None):
                     continue  # the byte size of the list it sizes: decoding read exactly that many bytes
             if isinstance(f, Scalar) and f.value is not None:
-                expected = expression.render(f.value, self.local_named)
+                # a fixed-size field may be read within a run of fixed fields, with no list of its own: its length
+                # is known
+                known = expression.with_lengths(f.value, fixed_lengths(fields))
+                expected = expression.render(known, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
                 if expression.fails(f.value):  # a divisor of 0 or a negative shift from the wire: a bad frame
                     reason = f"{f.name}: {shown} has no value here (a division by 0 or a negative shift)"

@@ -356,6 +356,8 @@ class BytesKind(Kind[Bytes]):
     def blank(self, f: Bytes) -> str:
         if f.default is not None:
             return repr(f.default.hex(" "))
+        if f.size_from:  # as many as the request asks for (zeros)
+            return f"lambda request: ' '.join(['00'] * request[{f.size_from!r}])"
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
 
 

@@ -86,11 +86,23 @@ def sized_apart(messages: Iterable[Message], by_request: bool = False) -> bool:
 
 
 def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
-    """Responses by the request they answer: their own command's, or the one they say they `answers`."""
+    """Responses by the request they answer: their own command's, or the one they say they `answers`.
+
+    A response the device also sends on its own (`unsolicited`) answers only the request it names in `answers`,
+    and a request whose `answered_by` names it (a sensor's measurement, streamed, or sent when polled: SDS011,
+    PMS5003 in passive mode); never its own command's request, which a device streaming it does not await."""
+    messages = list(responses)
+    requests = {m.key for m in messages if m.direction == Direction.REQUEST}
     index: dict[str, Message] = {}
-    for response in responses:
-        if response.direction == Direction.RESPONSE and not response.unsolicited:
+    for response in messages:
+        if response.direction != Direction.RESPONSE:
+            continue
+        if not response.unsolicited:
             index.setdefault(response.answers or response.key, response)
+        elif response.answers:
+            index.setdefault(response.answers, response)
+        elif response.key not in requests:
+            index.setdefault(response.key, response)  # reached only by an `answered_by` naming it
     return index
 
 

@@ -79,6 +79,7 @@ class Commands(FieldResolver):
             if isinstance(layout, dict):
                 sources.append((("framing", "layouts", name, "elements"), layout.get("elements")))
         found: list[tuple[Path, str]] = []
+        coded: set[str] = set()  # the layouts whose command element gives it ("": the one layout)
         for path, elements in sources:
             for name, item in elements.items() if isinstance(elements, dict) else ():
                 if isinstance(item, dict) and "reply_code" in item:
@@ -87,6 +88,7 @@ class Commands(FieldResolver):
                         self.error(where, "`reply_code` goes on the command element")
                     else:
                         found.append((where, str(item["reply_code"])))
+                        coded.add(str(path[2]) if len(path) > 3 else "")
         if not found:
             return commands
         if len({text for _, text in found}) > 1:
@@ -100,7 +102,15 @@ class Commands(FieldResolver):
         if set(expression.names(expr)) != {"code"}:
             self.error(where, "an expression of `code` (the request's code), e.g. `code | 0x40`")
             return commands
-        element = next((e for e in framing.layouts[Direction.RESPONSE].elements if e.role == "command"), None)
+        # where layouts are chosen by command, a layout without it (HLK-LD2410's reports beside its commands and
+        # ACKs) carries its commands' own codes; otherwise every layout holds every command, and gives it
+        by_layout = framing.by_command and len(framing.alternatives[Direction.RESPONSE]) > 1
+        response_layouts = [
+            layout
+            for layout in framing.alternatives[Direction.RESPONSE]
+            if not by_layout or layout.name in coded or (not layout.name and "" in coded)
+        ]
+        element = next((e for e in response_layouts[0].elements if e.role == "command"), None)
         if element is None or element.type is None or element.constant:
             self.error(where, "response frames carry no command code (the element is limited to requests or constant)")
             return commands
@@ -114,7 +124,11 @@ class Commands(FieldResolver):
         self.ctx.framing = replace(framing, reply_code=shown)
         resolved = []
         for command in commands:
-            replies = any(m.direction == Direction.RESPONSE for m in command.messages())
+            replies = any(
+                m.direction == Direction.RESPONSE
+                and (not by_layout or framing.layout_of(Direction.RESPONSE, m.layout) in response_layouts)
+                for m in command.messages()
+            )
             if (
                 isinstance(command.code, int)
                 and not isinstance(command.code, bool)

@@ -594,15 +594,39 @@ class DevicePass(Pass):
                     else [(f"the {m.key} response", f) for m, f in every.get(head, [])]
                 )
                 if not owners:
-                    self.error(at, f"unknown response field {name!r}: no response carries it")
+                    if not self.in_broken_response(head):  # else the response's own mistake is the line to read
+                        self.error(at, f"unknown response field {name!r}: no response carries it")
                     continue
                 for shown, owner in owners:  # a reply value goes to every response that has the field
                     if bit and bit not in {b.name for b in getattr(owner, "bits", ())}:
                         self.error(at, f"{shown}'s {head} has no bit field {bit!r}")
+                    elif not bit and where == ("reply",) and isinstance(owner, Scalar) and owner.bits:
+                        bit_names = [b.name for b in owner.bits]
+                        # the simulator builds the value from its bit fields: a whole number is no value of it
+                        self.error(
+                            at,
+                            f"{shown}'s {head} is made of bit fields: give each as `{head}.{bit_names[0]}: ...` "
+                            f"(its bit fields: {', '.join(bit_names)})",
+                        )
+                        break
                     elif isinstance(given, list):
                         problem = list_problem(given, owner)
                         if problem:
                             self.error(at, f"{shown}'s {head}: {problem}")
+
+    def in_broken_response(self, name: str) -> bool:
+        """Whether a response declares the field though none resolved carries it: the field (or its response) failed
+        to resolve, and that mistake is reported; a reply value for it is no second one."""
+        for raw in self.section("commands").values():
+            messages = [raw.get("response")] if isinstance(raw, dict) else []
+            subcommands = raw.get("subcommands") if isinstance(raw, dict) else None
+            if isinstance(subcommands, dict):
+                messages += [sub.get("response") for sub in subcommands.values() if isinstance(sub, dict)]
+            for response in messages:
+                fields = response.get("fields") if isinstance(response, dict) else None
+                if isinstance(fields, dict) and name in fields:
+                    return True
+        return False
 
     def timeout(
         self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]

@@ -113,6 +113,14 @@ class FieldResolver(Pass):
                 other = by_name.get(getattr(node, "name", ""))
                 if isinstance(node, expression.Length) and other is not None and not isinstance(other, LISTS):
                     self.error(where, f"len({node.name}): {node.name} is not a list, bytes or text")
+                elif isinstance(node, expression.Length) and isinstance(other, Text):
+                    # its characters are not its bytes (UTF-8, 7-bit pairs): a value of them made frames that do
+                    # not decode
+                    self.error(
+                        where,
+                        f"len({node.name}): {node.name} is text, whose characters are not its bytes; size it by a "
+                        f"field (`size: {field.name}`), which encode then writes",
+                    )
                 integer = isinstance(other, Scalar) and not other.type.is_float
                 if isinstance(node, expression.Name) and other is not None and not integer:
                     self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")

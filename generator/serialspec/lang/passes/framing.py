@@ -394,11 +394,19 @@ class FramingPass(FieldResolver):
                 default = (names[content_index], names[content_index]) if content_index >= 0 else None
                 counts = self.span(item.get("counts"), direction, names, (*e_path, "counts"), default)
                 a, b = names.index(counts[0]), names.index(counts[1])
-                if index == a < b and element.type is not None:
-                    # a length that counts itself (LX-16A, Hiwonder: N parameters + 3) is one that counts from the
-                    # next element and adds its own size
-                    a, counts = a + 1, (names[a + 1], counts[1])
-                    element = replace(element, adds=element.adds + element.type.size)
+                before = elements[a:index]  # elements of fixed size before it that it counts too, and itself
+                if (
+                    a <= index < b
+                    and element.type is not None
+                    and all(e.size is not None for e in before)
+                    and not (transparency and before and t_first <= index)
+                ):
+                    # a length that counts itself (LX-16A, Hiwonder: N parameters + 3), or from an element before it
+                    # (Benewake TFmini Plus: the whole frame, from its header), is one that counts from the next
+                    # element and adds the size of those
+                    fixed = sum(e.size or 0 for e in before) + element.type.size
+                    a, counts = index + 1, (names[index + 1], counts[1])
+                    element = replace(element, adds=element.adds + fixed)
                 if index >= a or (transparency and index > t_last):
                     raise self.fail(e_path, "the length must come before what it counts (and before the span's end)")
                 within = transparency is not None and t_first <= a and b <= t_last  # it counts plain bytes

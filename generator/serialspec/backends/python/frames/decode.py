@@ -213,7 +213,11 @@ def dispatch_lines(target: Target, code: str, arguments: str, nullable: bool) ->
             f"if {known}{code} & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
             f"    return {table}[ERROR_REPLY]({arguments}, {code} & {target.error_keep:#04x})",
         ]
-    unknown = f'f"unknown command {{{code}:#04x}}"' if code != "None" else '"unknown command None"'
+    unknown = (
+        f'f"unknown command {{{code}:#04x}}"'
+        if code != "None"
+        else f'"the protocol has no {target.upper.lower()} without a code"'  # (none of this direction at all)
+    )
     lines += [
         "try:",
         f"    decoder = {table}[{code}]",

@@ -17,7 +17,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError
 
-mh_z19 = pytest.importorskip("mh_z19")  # pulls in getrpimodel and gpiozero: may be missing elsewhere
+try:  # the peer pulls in gpiozero and lgpio, which has no wheel for every Python: not in the test extra
+    import mh_z19  # type: ignore[import-not-found]
+except ImportError:
+    mh_z19 = None
+PEER = pytest.mark.skipif(mh_z19 is None, reason="mh-z19 is not installed (pip install mh-z19 to run the peer tests)")
 
 SPEC = Path(__file__).parent / "specs" / "winsen_mhz19.yaml"  # not mh_z19: the peer's module name
 
@@ -41,6 +45,7 @@ class Recorder:
         pass
 
 
+@PEER
 @pytest.mark.parametrize(
     ("call", "name", "fields"),
     [
@@ -70,26 +75,30 @@ def test_the_peers_commands_are_our_requests(
 @given(
     co2=st.integers(0, 0xFFFF), temperature=st.integers(0, 255), status=st.integers(0, 255), rest=st.integers(0, 0xFFFF)
 )
-def test_the_peers_checksum_is_ours(mhz: ModuleType, co2: int, temperature: int, status: int, rest: int) -> None:
+def test_the_checksum_is_the_datasheets(mhz: ModuleType, co2: int, temperature: int, status: int, rest: int) -> None:
+    """The datasheet's rule, (~sum of bytes 1..7) + 1, and the peer's checksum() where it is installed."""
     reply = mhz.ReadCo2Response(co2=co2, temperature=temperature, status=status, reserved=rest)
     frame = mhz.encode(reply)
     assert frame[:2] == b"\xff\x86" and len(frame) == 9
-    assert mh_z19.checksum(frame[1:-1]) == frame[-1:]
+    assert frame[-1] == (0xFF - sum(frame[1:-1]) + 1) & 0xFF
+    if mh_z19 is not None:
+        assert mh_z19.checksum(frame[1:-1]) == frame[-1:]
     assert mhz.decode(frame, mhz.Direction.RESPONSE) == reply
     with pytest.raises(ChecksumError):
         mhz.decode(frame[:-1] + bytes([frame[-1] ^ 0x10]), mhz.Direction.RESPONSE)
 
 
-def test_the_peer_reads_the_sim(mhz: ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_peer_and_our_client_read_the_sim(mhz: ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:
     with simulated("winsen_mhz19") as path:
-        monkeypatch.setattr(mh_z19, "serial_dev", path)
-        assert mh_z19.read_all(serial_console_untouched=True) == {
-            "co2": 608,
-            "temperature": 31,
-            "TT": 71,
-            "SS": 0,
-            "UhUl": 0,
-        }
+        if mh_z19 is not None:
+            monkeypatch.setattr(mh_z19, "serial_dev", path)
+            assert mh_z19.read_all(serial_console_untouched=True) == {
+                "co2": 608,
+                "temperature": 31,
+                "TT": 71,
+                "SS": 0,
+                "UhUl": 0,
+            }
         client_module = importlib.import_module("winsen_mhz19.client")
         with client_module.WinsenMhz19Client(path, timeout=2) as client:
             reply = client.read_co2()

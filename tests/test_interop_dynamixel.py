@@ -24,6 +24,13 @@ ADDRESS = {r.name: r.address for r in CONTROL_TABLE.by_address.values()}
 SIM = ("dynamixel_p2.yaml", 1, 2, 3)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
+@pytest.fixture(autouse=True)
+def patient_sdk(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The SDK waits twice its LATENCY_TIMER (16 ms, a USB adapter's) and the bytes' time for a status packet: on a
+    loaded machine the simulator can take longer (a reset once failed so under a load of 6 on 2 cores)."""
+    monkeypatch.setattr("dynamixel_sdk.port_handler.LATENCY_TIMER", 250)
+
+
 @pytest.fixture
 def sdk(port: str) -> Iterator[tuple[Any, Any]]:
     handler = dxl.PortHandler(port)

@@ -1621,8 +1621,6 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
     back)."""
     from serialspec.backends import emit
     from serialspec.lang.passes.text import KINDS
-    from serialspec.runtime.text import TextField, TextRepeat
-    from test_text_frames import sentence_values
 
     protocol = resolve(load_text(yaml.safe_dump(TEXT_CASE, sort_keys=False), "matrix_text.yaml"))
     assert protocol.text is not None
@@ -1647,16 +1645,7 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
     with imported("matrix_text", modules, "the language matrix") as package:
         for cls in package.MESSAGE_TYPES:
             direction = cls.DIRECTION.value
-            sentence = package.FRAMING.sentence(cls.CODE, direction)
-            assert all(isinstance(f, TextField | TextRepeat) for f in sentence.fields)
-            frames, messages = b"", []
-            for values in st_examples(sentence_values(sentence), 20):
-                message = cls.from_fields(values, talker="B")
-                frame = package.encode(message)
-                assert package.decode(frame, direction) == message
-                assert package.encode(package.decode(frame, direction)) == frame
-                frames += b"\x00garbage#\n" + frame
-                messages.append(message)
+            frames, messages = random_frames(package, cls, 20)
             parser = package.StreamParser(direction)
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
         # the device answers the request under its code, as `device.commands.dial` says
@@ -1770,3 +1759,126 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
         device = importlib.import_module("matrix_text.simulator").SIMULATOR()
         sent = [package.decode(frame, "response") for _, frame in device.due()]
         assert any(isinstance(m, package.ReportResponse) and m.lvl == 0 for m in sent), sent
+
+
+def random_frames(package: ModuleType, cls: Any, count: int) -> tuple[bytes, list[Any]]:
+    """`count` random messages of a text message class, each checked to round trip (decode, and encode again byte
+    for byte): their frames, each after some garbage, and the messages."""
+    from serialspec.runtime.text import TextField, TextRepeat
+    from test_text_frames import sentence_values
+
+    direction = cls.DIRECTION.value
+    sentence = package.FRAMING.sentence(cls.CODE, direction)
+    assert all(isinstance(f, TextField | TextRepeat) for f in sentence.fields)
+    frames, messages = b"", []
+    for values in st_examples(sentence_values(sentence), count):
+        message = cls.from_fields(values, talker="B")
+        frame = package.encode(message)
+        assert package.decode(frame, direction) == message, frame
+        assert package.encode(package.decode(frame, direction)) == frame
+        frames += b"\x00garbage#\n" + frame
+        messages.append(message)
+    return frames, messages
+
+
+def python_and_markdown(case: dict[str, Any], refused: str) -> dict[str, str]:
+    """A text case's files from every output but C and Wireshark (each verified), which refuse it in one line."""
+    from serialspec.backends import Unsupported
+
+    protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    files: dict[str, str] = {}
+    for emitter in emitters():
+        if emitter.name in ("c", "wireshark"):
+            with pytest.raises(Unsupported, match=refused):
+                emitter.files(protocol)
+            continue
+        emitted = emitter.files(protocol)
+        assert emitter.verify is None or emitter.verify(protocol, emitted) == []
+        files.update(emitted)
+    return files
+
+
+def test_a_decimal_text_checksum_through_every_output() -> None:
+    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): the C target and the dissector refuse it in one line;
+    the reference says how it is written; the package writes the checksum in decimal (no leading zeros), reads it
+    back, refuses a wrong one and random messages round trip, byte by byte through the stream parser too."""
+    from serialspec.runtime.errors import ChecksumError
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"] = {"algorithm": "xor", "format": "decimal", "marker": "!"}
+    files = python_and_markdown(case, r"^a text checksum written in decimal \(`format: decimal`\)$")
+    assert "`!` + its value in decimal digits (0 to 255)" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        frame = package.encode(package.AnswerResponse(talker="A", ok=package.Side.NORTH))
+        assert frame == b"#AOK;N!%d\n" % (ord("A") ^ ord("O") ^ ord("K") ^ ord(";") ^ ord("N")), frame
+        assert package.decode(frame) == package.AnswerResponse(talker="A", ok=package.Side.NORTH)
+        with pytest.raises(ChecksumError, match="checksum 7 does not match the frame's"):
+            package.decode(b"#AOK;N!7\n")
+        with pytest.raises(ChecksumError, match="is not a decimal number of 1 to 3 digits"):
+            package.decode(b"#AOK;N!1F\n")
+        for cls in package.MESSAGE_TYPES:
+            direction = cls.DIRECTION.value
+            frames, messages = random_frames(package, cls, 10)
+            for frame in frames.split(b"\x00garbage#\n")[1:]:
+                written = frame[frame.rindex(b"!") + 1 : -1]
+                assert written.isdigit() and (written == b"0" or not written.startswith(b"0")), frame
+            parser = package.StreamParser(direction)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_messages_found_by_their_code_alone_through_every_output() -> None:
+    """A message's own `text:` without a `start` (found by its code: Roboteq's `A=12:13`) and with `after_code`
+    (`""`: the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins:
+    C and Wireshark refuse it in one line; the reference says how it is written; random messages round trip and are
+    found byte by byte among the others; codes that a frame could not tell apart are refused, one line each."""
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["glued"] = {
+        "code": "GL",
+        "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
+    }
+    case["commands"]["longer"] = {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}}
+    case["commands"]["pairs"] = {
+        "code": "PR",
+        "response": {
+            "unsolicited": True,
+            "text": {"separator": "=", "list": ":"},
+            "fields": {"vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}}},
+        },
+    }
+    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    docs = files["docs/matrix_text.md"]
+    assert "found by its code: the code, the first field right after the code" in docs, docs
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        glued = package.GluedResponse(talker="A", n=-12)
+        assert package.encode(glued).startswith(b"#AGL-12!")
+        assert package.decode(package.encode(glued)) == glued
+        assert package.decode(package.encode(package.GluedResponse(talker="A"))) == package.GluedResponse(talker="A")
+        assert package.encode(package.PairsResponse.from_fields({"vals": [{"v": 1}]}, "B")).startswith(b"#BPR=1:!")
+        frames, messages = b"", []
+        for cls in (package.GluedResponse, package.LongerResponse, package.PairsResponse):
+            more, decoded = random_frames(package, cls, 10)
+            frames, messages = frames + more, messages + decoded
+        parser = package.StreamParser("response")
+        assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+    for change, expected in (
+        ({"longer": {"code": "GL5"}}, "the code 'GL' then '' begins the code 'GL5': a frame could be either"),
+        ({"glued": {"response": {"fields": {"n": "text"}}}}, "the code 'GL' then '' begins the code 'GLX'"),
+        ({"pairs": {"response": {"text": {"after_code": "=="}}}}, "`after_code` is one character, or empty"),
+        ({"pairs": {"response": {"text": {"after_code": "!"}}}}, "`after_code` differs from the framing's"),
+    ):
+        broken = copy.deepcopy(case)
+        for command, keys in change.items():
+            target = broken["commands"][command]
+            for key, value in keys.items():
+                if isinstance(value, dict):
+                    for inner, item in value.items():
+                        target[key][inner] = {**target[key][inner], **item} if isinstance(item, dict) else item
+                else:
+                    target[key] = value
+        with pytest.raises(SpecErrors) as refused:
+            resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+        lines = str(refused.value).splitlines()
+        assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "b8d48b01cec37652cb102a93eb32a9e4d3b081e0b6ad82fea3197523fec7e49a"
+#define NMEA0183_SPEC_SHA256 "e3eee91fa2bdbd820ad002233e123bd2097742baf4ddc1a010993cf529ac0dde"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -569,11 +569,25 @@ TEXT_LAYOUT = Obj(
     {
         "start": Str(
             "What the message's text starts with, right after the framing's own start (GRBL's status report: `<`); "
-            "not a letter, digit or character of a text code: frames are told apart by it.",
+            "not a letter, digit or character of a text code: frames are told apart by it. Without one the message "
+            "is found by its code at the start of the frame (after the talker), the longest code that fits: the "
+            "code, then `after_code`, then the fields (Roboteq's `A=12:13` answering `?A`: `text: {separator: "
+            '"=", list: ":"}`).',
             example="<",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
-        "separator": Str("One character between the code and the fields, and between fields (`|`).", example="|"),
+        "separator": Str(
+            "One character between the code and the fields, and between fields (`|`); default the framing's.",
+            example="|",
+        ),
+        "after_code": Str(
+            "What comes between the code and the first field, in place of `separator` (at most one character): "
+            'empty glues the first value to the code (Lynxmotion LSS\'s `D1800`: `text: {after_code: ""}`; '
+            "G-code's line number `N123` before the line). A frame of the code alone carries no fields. A code "
+            "glued to its value may begin another code only where that value is a number and the other code goes "
+            "on with no digit or sign (LSS's `Q` beside `QD`): the longest code that fits is read.",
+            example="",
+        ),
         "named": Str(
             "One character between a field's `label` and its value (`:`): every field has a label and is found "
             "by it, in any order.",
@@ -581,7 +595,6 @@ TEXT_LAYOUT = Obj(
         ),
         "list": Str("One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`).", example=","),
     },
-    required=("start", "separator"),
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
     "checksum and line end stay the framing's.",
@@ -1168,11 +1181,15 @@ FRAMING = Obj(
                     choices=("sum", "xor"),
                 ),
                 "invert": Bool("sum: bitwise NOT of the sum.", default=False, example=True),
-                "marker": Str("The character before the checksum's hex digits.", default="*"),
+                "marker": Str("The character before the checksum's digits.", default="*"),
                 "format": Str(
-                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum).",
-                    choices=("hex2",),
+                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum, NMEA 0183); "
+                    "decimal, its value in decimal digits without leading zeros, 0 to 255 (G-code's line checksum, "
+                    "Marlin and RepRap firmware: `N1 G28*18`; ODrive's ASCII protocol). The C target and the "
+                    "Wireshark dissector refuse a decimal one, saying so.",
+                    choices=("hex2", "decimal"),
                     default="hex2",
+                    example="decimal",
                 ),
                 "required": Bool(
                     "Frames without a checksum are refused (false: accepted unchecked, as NMEA 0183 allows for "
@@ -1184,7 +1201,7 @@ FRAMING = Obj(
             required=("algorithm",),
             description=(
                 "text: the checksum over the characters between `start` and `marker`, written after `marker` as "
-                "hex digits, before the line ending."
+                "hex digits (or decimal ones: `format`), before the line ending."
             ),
         ),
         "talker": Obj(

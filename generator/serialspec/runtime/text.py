@@ -132,11 +132,12 @@ class TextLayout:
     value, found by the label in any order (an absent label: None), the field labelled with the code right after
     the code (`Hold:0`); a repeat's values are joined by `list`."""
 
-    start: str
+    start: str = ""
     end: str = ""
     separator: str = ","
     named: str = ""
     list: str = ""
+    after_code: str | None = None  # between the code and the first field (None: the separator; "": glued: `D1800`)
 
 
 @dataclass(frozen=True)
@@ -180,8 +181,9 @@ class Sentence:
 class TextFraming:
     """The frame: `start` + address (talker + code) + separator-joined fields + [marker + checksum as hex] + `end`.
 
-    checksum: the function over the characters between start and marker (from the checksum registry); `required`
-    says whether a frame without one is refused. talker: how many leading characters of the address are the
+    checksum: the function over the characters between start and marker (from the checksum registry), written as
+    `digits` upper-case hex digits or, with `decimal`, in decimal digits without leading zeros (G-code's `*71`);
+    `required` says whether a frame without one is refused. talker: how many leading characters of the address are the
     frame-level value (0: none). max_length: longest frame the stream parser waits for, in characters.
     """
 
@@ -196,18 +198,23 @@ class TextFraming:
     talker: int = 0
     talkers: tuple[str, ...] = ()  # the talker values encode accepts (empty: any)
     max_length: int = 82
+    decimal: bool = False  # the checksum written in decimal (G-code: `N1 G28*18`), not as `digits` hex digits
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
     layouts: tuple[TextLayout, ...] = field(init=False, repr=False, compare=False)  # the messages' own, each once
+    # the messages found by their code alone (their own text without a start), the longest code first
+    alone: tuple[TextSentence, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         by_code: dict[str, dict[str, TextSentence]] = {}
         for sentence in self.sentences:
             by_code.setdefault(sentence.code, {})[sentence.direction] = sentence
         object.__setattr__(self, "by_code", by_code)
-        layouts = {s.layout: None for s in self.sentences if s.layout is not None}
+        layouts = {s.layout: None for s in self.sentences if s.layout is not None and s.layout.start}
         object.__setattr__(self, "layouts", tuple(layouts))
+        alone = [s for s in self.sentences if s.layout is not None and not s.layout.start]
+        object.__setattr__(self, "alone", tuple(sorted(alone, key=lambda s: -len(s.code))))
 
     def sentence(self, code: str, direction: str | None = None, asked: bool = False) -> TextSentence:
         """The message a code names, in `direction` where the code names one each way; DecodeError where there is
@@ -245,6 +252,10 @@ class TextFraming:
         parts = body.split(self.separator)
         address = parts[0]
         talker, code = address[: self.talker], address[self.talker :]
+        if self.alone and not self._plain(code, direction):
+            found = self._decode_alone(talker, body[self.talker :], direction)
+            if found is not None:
+                return found
         if reply is not None and direction != "request":
             bare = self.by_code.get(reply, {}).get("response")
             if bare is not None and bare.bare and not self._coded(code, direction):
@@ -252,6 +263,42 @@ class TextFraming:
         sentence = self.sentence(code, direction, reply is not None)
         values = _decode_fields(sentence, parts[1:])
         return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
+
+    def _plain(self, code: str, direction: str | None) -> bool:
+        """Whether `code` is that of a message sent in the framing's own text (no layout of its own), in
+        `direction` (None: either)."""
+        found = self.by_code.get(code, {}).values()
+        return any(s.layout is None and not s.bare and direction in (None, s.direction) for s in found)
+
+    def _decode_alone(self, talker: str, text: str, direction: str | None) -> Sentence | None:
+        """A frame of a message found by its code alone (its own text without a start): the longest such code the
+        text starts with, then the layout's `after_code` and fields; None when no such code fits."""
+        matched: list[tuple[TextSentence, str | None]] = []
+        for sentence in self.alone:
+            layout = sentence.layout
+            if layout is None or direction not in (None, sentence.direction) or not text.startswith(sentence.code):
+                continue
+            if matched and len(sentence.code) < len(matched[0][0].code):
+                break
+            rest = text[len(sentence.code) :]
+            after = layout.separator if layout.after_code is None else layout.after_code
+            if not rest:
+                matched.append((sentence, None))
+            elif rest.startswith(after) and rest.endswith(layout.end):
+                matched.append((sentence, rest[len(after) : len(rest) - len(layout.end)]))
+        if not matched:
+            return None
+        if len(matched) > 1:
+            raise DirectionNeeded(matched[0][0].code)
+        sentence, inner = matched[0]
+        layout = sentence.layout
+        assert layout is not None  # every message in `alone` has its own text
+        texts = inner.split(layout.separator) if inner else []  # the code alone: no fields
+        if layout.named:
+            values = _decode_labelled(sentence, layout, texts)
+        else:
+            values = _decode_fields(sentence, [t for p in texts for t in _split(p, layout.list)])
+        return Sentence(talker, sentence.code, values, -1, sentence.direction)
 
     def _coded(self, code: str, direction: str | None) -> bool:
         """Whether a frame's first field is the code of a message sent with its code, in `direction` (None: either;
@@ -283,9 +330,15 @@ class TextFraming:
                 raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
             return body
         written, covered = body[at + len(self.marker) :], body[:at]
+        computed = self.checksum(covered.encode("ascii"))
+        if self.decimal:
+            if not 1 <= len(written) <= 3 or any(c not in _DIGITS for c in written):
+                raise ChecksumError(f"checksum {shown(written)} is not a decimal number of 1 to 3 digits")
+            if int(written) != computed:
+                raise ChecksumError(f"checksum {written} does not match the frame's {computed}")
+            return covered
         if len(written) != self.digits or not written or any(c not in _HEX_DIGITS for c in written):
             raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
-        computed = self.checksum(covered.encode("ascii"))
         if int(written, 16) != computed:
             raise ChecksumError(f"checksum {written} does not match the frame's {computed:0{self.digits}X}")
         return covered
@@ -321,7 +374,8 @@ class TextFraming:
         """The text between start and checksum marker, framed."""
         text = self.start + body
         if self.checksum is not None:
-            text += f"{self.marker}{self.checksum(body.encode('ascii')):0{self.digits}X}"
+            value = self.checksum(body.encode("ascii"))
+            text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
         return (text + self.end).encode("ascii")
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
@@ -337,6 +391,7 @@ class TextFraming:
 # a sentence, and `serialspec decode PACKAGE SENTENCE` would compile each on every start. A digit is what \d matches
 # (str.isdecimal: any Unicode decimal digit, as int() and Decimal() read them).
 _HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
+_DIGITS = frozenset("0123456789")
 
 
 def _unsigned(text: str) -> str:
@@ -384,7 +439,9 @@ def _encode_in(
 ) -> str:
     """The text of a message in its own layout: start, address, fields (labelled ones only where they have a value),
     end."""
-    forbidden += "".join({layout.start, layout.end, layout.separator, layout.named, layout.list} - {""})
+    forbidden += "".join(
+        {layout.start, layout.end, layout.separator, layout.named, layout.list, layout.after_code or ""} - {""}
+    )
     parts = [address]
     for item in sentence.fields:
         value = values.get(item.name)
@@ -401,7 +458,11 @@ def _encode_in(
         texts = _encode_fields(single, {item.name: value}, forbidden)
         joined = (layout.list or layout.separator).join(texts)
         parts.append(f"{item.label}{layout.named}{joined}" if layout.named else joined)
-    return layout.start + layout.separator.join(parts) + layout.end
+    after = layout.separator if layout.after_code is None else layout.after_code
+    joined = layout.separator.join(parts[1:])
+    # found by its code alone: a frame whose fields have no text is the code alone
+    fields = after + joined if len(parts) > 1 and (joined or layout.start) else ""
+    return layout.start + parts[0] + fields + layout.end
 
 
 def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:

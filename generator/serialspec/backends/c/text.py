@@ -38,6 +38,8 @@ def refuse(text: TextFrame) -> None:
         raise Unsupported("a message's own text layout (`text:`)")
     if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
+    if text.checksum is not None and text.checksum_format == "decimal":
+        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")

@@ -4,6 +4,7 @@ each example shown character by character."""
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import assert_never
 
 from serialspec.backends.markdown.docs import cell, code_span, period_text, text
 from serialspec.backends.markdown.kinds import anchor
@@ -60,6 +61,14 @@ def _layout_text(layout: TextLayout) -> str:
         )
     values = f"; a repeat's values joined by {code_span(layout.list)}" if layout.list else ""
     end = f", then {code_span(layout.end)}" if layout.end else ""
+    if layout.after_code == "":
+        fields = "the first field right after the code, " + fields.replace("each field", "each other field")
+    elif layout.after_code is not None:
+        fields = f"the first field after {code_span(layout.after_code)}, " + fields.replace(
+            "each field", "each other field"
+        )
+    if not layout.start:
+        return f"Its own text inside the frame, found by its code: the code, {fields}{values}{end}."
     return f"Its own text inside the frame: {code_span(layout.start)}, the code, {fields}{values}{end}."
 
 
@@ -117,8 +126,15 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
     yield f"| fields | each after {code_span(frame.separator)} | an empty field is None |"
     if frame.checksum is not None:
         optional = "" if frame.required else "; optional: a frame without it is accepted unchecked"
+        match frame.checksum_format:
+            case "hex2":
+                written = f"{frame.digits} hex digits"
+            case "decimal":
+                written = "its value in decimal digits (0 to 255)"
+            case _:
+                assert_never(frame.checksum_format)
         yield (
-            f"| checksum | {code_span(frame.marker)} + {frame.digits} hex digits | "
+            f"| checksum | {code_span(frame.marker)} + {written} | "
             f"{cell(frame.checksum.describe())} between start and marker{optional} |"
         )
     yield f"| end | {_shown(frame.end)} | ends every frame (at most {frame.max_length} characters before it) |"

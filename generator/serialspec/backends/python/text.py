@@ -247,6 +247,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield f"    checksum={checksum},"
     yield f"    marker={text.marker!r},"
     yield f"    digits={text.digits},"
+    if text.checksum_format == "decimal":
+        yield "    decimal=True,"
     yield f"    required={text.required},"
     yield f"    talker={text.talker},"
     yield f"    talkers={text.talkers!r},"
@@ -269,8 +271,9 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         yield f"            name={message.code!r},"
         yield f"            direction={message.direction.value!r},"
         if message.layout is not None:
+            keys = ("start", "end", "separator", "named", "list", "after_code")
             shown = ", ".join(
-                f"{k}={getattr(message.layout, k)!r}" for k in ("start", "end", "separator", "named", "list")
+                f"{k}={getattr(message.layout, k)!r}" for k in keys if getattr(message.layout, k) is not None
             )
             yield f"            layout=TextLayout({shown}),"
         if message.values_only:

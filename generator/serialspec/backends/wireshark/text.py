@@ -23,6 +23,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("a message's own text layout (`text:`)")
     if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
+    if text.checksum is not None and text.checksum_format == "decimal":
+        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

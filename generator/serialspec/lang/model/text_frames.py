@@ -46,11 +46,12 @@ class TextLayout:
     """A message's own text inside the frame (`text:`): start + code + separated fields + end; with `named`, fields
     found by their labels (label, `named`, value), a repeat's values joined by `list`."""
 
-    start: str
+    start: str = ""
     end: str = ""
     separator: str = ","
     named: str = ""
     list: str = ""
+    after_code: str | None = None  # between the code and the first field (None: the separator; "": glued)
 
 
 @frozen
@@ -131,6 +132,7 @@ class TextFrame:
     examples: tuple[TextExample, ...] = ()
     digits: int = 2
     device: TextDevice | None = None
+    checksum_format: Literal["hex2", "decimal"] = "hex2"  # how the checksum is written after the marker
 
     def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
         """The command's message in `direction` (its response by default: what a device sends)."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import string
 from dataclasses import replace
-from typing import Any, cast
+from typing import Any, Literal, cast
 
 from serialspec import checksums
 from serialspec.checksums import ChecksumProblem
@@ -86,6 +86,7 @@ class TextPass(Pass):
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
                 self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+        self.found_by_code(messages)
         responses = {m.key for m in messages if m.direction == Direction.RESPONSE}
         for message in messages:
             asked: Path = ("commands", message.key, "request", "answered_by")
@@ -122,9 +123,11 @@ class TextPass(Pass):
         algorithm = None
         marker = "*"
         required = True
+        written: Literal["hex2", "decimal"] = "hex2"
         if isinstance(checksum_raw, dict):
             marker = str(checksum_raw.get("marker", "*"))
             required = bool(checksum_raw.get("required", True))
+            written = "decimal" if checksum_raw.get("format") == "decimal" else "hex2"
             where = (*path, "checksum")
             try:
                 algorithm = checksums.from_spec(checksum_raw, 1, "u8", lambda at, text: self.error((*where, *at), text))
@@ -154,6 +157,7 @@ class TextPass(Pass):
             talker_description=str(talker.get("description", "")),
             max_length=int(raw.get("max_length", 82)),
             messages=(),
+            checksum_format=written,
         )
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
@@ -191,8 +195,8 @@ class TextPass(Pass):
             )
         fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
         layout = (
-            self.layout(raw["text"], code, fields, (*where, "text"), framing - {frame.separator} if frame else set())
-            if "text" in raw
+            self.layout(raw["text"], code, fields, (*where, "text"), frame)
+            if "text" in raw and isinstance(raw["text"], dict)
             else None
         )
         if layout is None:
@@ -226,22 +230,60 @@ class TextPass(Pass):
             values_only=values_only,
         )
 
+    def found_by_code(self, messages: list[TextMessage]) -> None:
+        """Each message found by its code alone (its own text without a `start`) is told from every other code: the
+        code and what follows it (`after_code`, else the separator) begin no other code, unless the code is glued
+        to a number and the other code goes on with no digit or sign (LSS's `Q6` beside `QD1800`)."""
+        codes = {m.code for m in messages}
+        for message in messages:
+            layout = message.layout
+            if layout is None or layout.start:
+                continue
+            after = layout.separator if layout.after_code is None else layout.after_code
+            first = message.fields[0] if message.fields else None
+            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal")
+            for other in sorted(codes):
+                if other == message.code or not other.startswith(message.code + after):
+                    continue
+                if after == "" and numeric and other[len(message.code)] not in "0123456789+-.":
+                    continue
+                where = ("commands", message.key, message.direction.value, "text")
+                self.error(
+                    where,
+                    f"the code {message.code!r} then {after!r} begins the code {other!r}: a frame could be either"
+                    + (" (glue only a number to a code another code begins with)" if after == "" else ""),
+                )
+
     def layout(
-        self, raw: dict[str, Any], code: str, fields: tuple[TextField | TextRepeat, ...], path: Path, framing: set[str]
+        self,
+        raw: dict[str, Any],
+        code: str,
+        fields: tuple[TextField | TextRepeat, ...],
+        path: Path,
+        frame: TextFrame | None,
     ) -> TextLayout:
         """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
-        layout = TextLayout(**{k: str(raw[k]) for k in ("start", "end", "separator", "named", "list") if k in raw})
-        if not layout.start or layout.start[0] in CODE_CHARACTERS:
+        framing = {frame.start, frame.marker, *frame.end} - {""} if frame is not None else set()
+        given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
+        given.setdefault("separator", frame.separator if frame is not None else ",")
+        layout = TextLayout(**given)
+        if layout.start and layout.start[0] in CODE_CHARACTERS:
             self.error((*path, "start"), "a message's text starts with a character no text code has (GRBL: `<`)")
         for key in ("separator", "named", "list"):
             value = getattr(layout, key)
             if key in raw and len(value) != 1:
                 self.error((*path, key), f"`{key}` is one character")
+        if layout.after_code is not None and len(layout.after_code) > 1:
+            self.error((*path, "after_code"), "`after_code` is one character, or empty (the value glued to the code)")
         single = [c for c in (layout.separator, layout.named, layout.list) if c]
         if len(set(single)) != len(single) or set(single) & framing:
             self.error(path, "`separator`, `named` and `list` differ from each other and from the framing's characters")
-        if set(code) & set(single):
+        if set(layout.after_code or "") & framing:
+            self.error((*path, "after_code"), "`after_code` differs from the framing's characters")
+        if set(code) & set(single + [layout.after_code or ""]) - {""}:
             self.error(path, f"the code {code!r} holds one of the message's own characters")
+        if not layout.start and any(item.label == code for item in fields):
+            self.error(path, "a field labelled with the code needs the message's own `start`")
         for item in fields:
             where = (*path[:-1], "fields", item.name)
             if layout.named and not item.label:

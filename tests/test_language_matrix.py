@@ -1882,3 +1882,33 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
             resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
         lines = str(refused.value).splitlines()
         assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines
+
+
+def test_a_text_checksum_in_one_direction_through_every_output() -> None:
+    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C and
+    Wireshark refuse it in one line; requests carry the checksum, responses none (a marker in one is text), with or
+    without the direction given; random messages round trip, through the stream parser too."""
+    from serialspec.runtime.errors import EncodeError
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"]["directions"] = ["request"]
+    files = python_and_markdown(case, r"^a text checksum in one direction only \(`checksum.directions`\)$")
+    assert "; requests only |" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        answer = package.AnswerResponse(talker="A", ok=package.Side.NORTH)
+        assert package.encode(answer) == b"#AOK;N\n"
+        assert package.decode(b"#AOK;N\n") == answer
+        dial = package.DialRequest(talker="A", level=7, note="ab")
+        assert package.encode(dial).startswith(b"#ADL;7;ab!")
+        assert package.decode(package.encode(dial), "request") == dial
+        with pytest.raises(EncodeError, match="holds '!', which a text frame cannot carry"):
+            package.encode(package.DialRequest(talker="A", level=7, note="a!b"))
+        reply = package.DialResponse(talker="A", level=7, note="x!y")
+        assert package.encode(reply) == b"#ADL;7;;;x!y\n"
+        assert package.decode(b"#ADL;7;;;x!y\n", "response") == reply
+        for cls in package.MESSAGE_TYPES:
+            direction = cls.DIRECTION.value
+            frames, messages = random_frames(package, cls, 10)
+            parser = package.StreamParser(direction)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "e3eee91fa2bdbd820ad002233e123bd2097742baf4ddc1a010993cf529ac0dde"
+#define NMEA0183_SPEC_SHA256 "8c113e761e43b506c1c2b6c498c0ecfe2d67644feb6191d315543563f2a55295"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -50,7 +50,9 @@ def describe(
         "sent": sentence.sent,
         # a frame whose checksum fails does not decode; one without a checksum (none in the framing, or left out
         # where `required: false` allows it) was not checked
-        "checksum_ok": True if framing.checksum is not None and framing.marker in body else None,
+        "checksum_ok": True
+        if framing.checksum is not None and framing.marker in body and sentence.direction in framing.checksummed
+        else None,
         "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
     }
 

@@ -593,7 +593,11 @@ TEXT_LAYOUT = Obj(
             "by it, in any order.",
             example=":",
         ),
-        "list": Str("One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`).", example=","),
+        "list": Str(
+            "One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`); needed with `named`, else "
+            "a repeat's values are separated as fields are.",
+            example=",",
+        ),
     },
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
@@ -1196,6 +1200,14 @@ FRAMING = Obj(
                     "some sentences).",
                     default=True,
                     example=False,
+                ),
+                "directions": ListOf(
+                    Str(choices=("request", "response")),
+                    "The directions whose frames carry it (default both): G-code's numbered lines carry one, the "
+                    "firmware's `ok` and `Resend: 124` none (`directions: [request]`); a frame of the other "
+                    "direction is text to its end, the marker too. The C target and the Wireshark dissector refuse "
+                    "a checksum in one direction only, saying so.",
+                    example=["request"],
                 ),
             },
             required=("algorithm",),

@@ -199,6 +199,7 @@ class TextFraming:
     talkers: tuple[str, ...] = ()  # the talker values encode accepts (empty: any)
     max_length: int = 82
     decimal: bool = False  # the checksum written in decimal (G-code: `N1 G28*18`), not as `digits` hex digits
+    checksummed: tuple[str, ...] = ("request", "response")  # the directions whose frames carry the checksum
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
@@ -245,7 +246,22 @@ class TextFraming:
         if not text.startswith(self.start):
             raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
         body = text[len(self.start) :]
-        body = self._checked(body)
+        if self.checksum is None or len(self.checksummed) == 2:
+            return self._decode_body(self._checked(body), direction, reply)
+        # a checksum in one direction only: a frame of the other is all text (its fields may hold the marker)
+        if direction is not None and direction not in self.checksummed:
+            return self._decode_body(body, direction, reply)
+        if direction is None:  # a frame that reads as the other direction's whole is one
+            try:
+                whole = self._decode_body(body, None, reply)
+            except DecodeError:
+                whole = None
+            if whole is not None and whole.direction not in self.checksummed:
+                return whole
+        return self._decode_body(self._checked(body), direction, reply)
+
+    def _decode_body(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """The text between start and checksum (the checksum checked) -> its sentence."""
         for layout in self.layouts:
             if body.startswith(layout.start) and body[len(layout.start) :].endswith(layout.end):
                 return self._decode_in(layout, body[len(layout.start) : len(body) - len(layout.end)], direction)
@@ -321,12 +337,12 @@ class TextFraming:
             values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
         return Sentence(talker, code, values, -1, sentence.direction)
 
-    def _checked(self, body: str) -> str:
+    def _checked(self, body: str, required: bool = True) -> str:
         if self.checksum is None:
             return body
         at = body.rfind(self.marker)
         if at < 0:
-            if self.required:
+            if self.required and required:
                 raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
             return body
         written, covered = body[at + len(self.marker) :], body[:at]
@@ -361,19 +377,20 @@ class TextFraming:
         if unknown:
             raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
         if sentence.layout is not None:
-            return self.frame(_encode_in(sentence, sentence.layout, values, talker + code, self._forbidden()))
-        parts = _encode_fields(sentence, values, self._forbidden())
+            inner = _encode_in(sentence, sentence.layout, values, talker + code, self._forbidden(sentence.direction))
+            return self.frame(inner, sentence.direction)
+        parts = _encode_fields(sentence, values, self._forbidden(sentence.direction))
         if sent >= 0:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
             parts = (parts + [""] * sent)[:sent]
         body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
-        return self.frame(body)
+        return self.frame(body, sentence.direction)
 
-    def frame(self, body: str) -> bytes:
-        """The text between start and checksum marker, framed."""
+    def frame(self, body: str, direction: str | None = None) -> bytes:
+        """The text between start and checksum marker, framed (with its checksum where `direction` has one)."""
         text = self.start + body
-        if self.checksum is not None:
+        if self.checksum is not None and (direction is None or direction in self.checksummed):
             value = self.checksum(body.encode("ascii"))
             text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
         return (text + self.end).encode("ascii")
@@ -381,8 +398,11 @@ class TextFraming:
     def encode_sentence(self, sentence: Sentence) -> bytes:
         return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction)
 
-    def _forbidden(self) -> str:
-        return "".join({self.start, self.separator, self.marker, *self.end})
+    def _forbidden(self, direction: str) -> str:
+        """The framing's own characters, which no field of a frame in `direction` may hold (the checksum's marker
+        only where that direction carries a checksum)."""
+        marker = self.marker if self.checksum is not None and direction in self.checksummed else ""
+        return "".join({self.start, self.separator, marker, *self.end} - {""})
 
 
 # --- fields -------------------------------------------------------------------------------------------------------
@@ -456,6 +476,8 @@ def _encode_in(
             continue  # an absent label
         single = TextSentence(sentence.code, (item,), sentence.where)
         texts = _encode_fields(single, {item.name: value}, forbidden)
+        if not texts:
+            continue  # a repeat of no groups (at the end, `max_count`): nothing, not an empty field
         joined = (layout.list or layout.separator).join(texts)
         parts.append(f"{item.label}{layout.named}{joined}" if layout.named else joined)
     after = layout.separator if layout.after_code is None else layout.after_code

@@ -40,6 +40,8 @@ def refuse(text: TextFrame) -> None:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
     if text.checksum is not None and text.checksum_format == "decimal":
         raise Unsupported("a text checksum written in decimal (`format: decimal`)")
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")

@@ -126,6 +126,8 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
     yield f"| fields | each after {code_span(frame.separator)} | an empty field is None |"
     if frame.checksum is not None:
         optional = "" if frame.required else "; optional: a frame without it is accepted unchecked"
+        if frame.checksum_directions != ("request", "response"):
+            optional += f"; {' and '.join(d + 's' for d in frame.checksum_directions)} only"
         match frame.checksum_format:
             case "hex2":
                 written = f"{frame.digits} hex digits"

@@ -249,6 +249,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield f"    digits={text.digits},"
     if text.checksum_format == "decimal":
         yield "    decimal=True,"
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        yield f"    checksummed={text.checksum_directions!r},"
     yield f"    required={text.required},"
     yield f"    talker={text.talker},"
     yield f"    talkers={text.talkers!r},"

@@ -25,6 +25,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
     if text.checksum is not None and text.checksum_format == "decimal":
         raise Unsupported("a text checksum written in decimal (`format: decimal`)")
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

@@ -124,7 +124,10 @@ class TextPass(Pass):
         marker = "*"
         required = True
         written: Literal["hex2", "decimal"] = "hex2"
+        carried: tuple[str, ...] = ("request", "response")
         if isinstance(checksum_raw, dict):
+            if checksum_raw.get("directions"):
+                carried = tuple(d for d in ("request", "response") if d in checksum_raw["directions"])
             marker = str(checksum_raw.get("marker", "*"))
             required = bool(checksum_raw.get("required", True))
             written = "decimal" if checksum_raw.get("format") == "decimal" else "hex2"
@@ -158,6 +161,7 @@ class TextPass(Pass):
             max_length=int(raw.get("max_length", 82)),
             messages=(),
             checksum_format=written,
+            checksum_directions=carried,
         )
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
@@ -288,8 +292,8 @@ class TextPass(Pass):
             where = (*path[:-1], "fields", item.name)
             if layout.named and not item.label:
                 self.error(where, "with `text.named` every field needs a `label`")
-            if isinstance(item, TextRepeat) and not layout.list:
-                self.error(where, "a repeat in a message's own text needs `text.list` between its values")
+            if isinstance(item, TextRepeat) and layout.named and not layout.list:
+                self.error(where, "a labelled repeat needs `text.list` between its values")
             if isinstance(item, TextRepeat) and any(f.label for f in item.fields):
                 self.error(where, "a label goes on the repeat, not on its fields")
             if isinstance(item, TextRepeat) and item.label == code:

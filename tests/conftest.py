@@ -322,6 +322,16 @@ def scratch_folder(prefix: str) -> Path:
     return Path(folder.name)
 
 
+def generate_afresh(spec: Path, tmp_path_factory: pytest.TempPathFactory, name: str) -> ModuleType:
+    """The package `name` generated from `spec` into a new temporary folder and imported, any package of that name
+    imported before (another test's spec of the same protocol) forgotten first: a module fixture's one generation."""
+    import sys
+
+    for module in [m for m in sys.modules if m.partition(".")[0] == name]:
+        del sys.modules[module]
+    return generate_and_import(spec, tmp_path_factory.mktemp(name), name)
+
+
 def generate_and_import(spec: Path, out: Path, name: str) -> ModuleType:
     """`serialspec generate SPEC --out OUT`, then the package `name` imported from OUT (a spec of a test's own)."""
     import sys

@@ -1912,3 +1912,28 @@ def test_a_text_checksum_in_one_direction_through_every_output() -> None:
             frames, messages = random_frames(package, cls, 10)
             parser = package.StreamParser(direction)
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_an_optional_text_checksum_after_a_separator_through_every_output() -> None:
+    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): C and Wireshark refuse
+    it in one line; requests write the separator before the marker, covered by the checksum, responses do not; a
+    frame sent without the checksum decodes and encodes again without it; random messages round trip."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"].update({"required": False, "separated": ["request"]})
+    files = python_and_markdown(case, r"^a separator before the text checksum \(`checksum.separated`\)$")
+    assert "requests write `;` before the marker, covered by it" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        dial = package.DialRequest(talker="A", level=7, note="ab")
+        frame = package.encode(dial)
+        assert frame.startswith(b"#ADL;7;ab;!") and package.decode(frame, "request") == dial
+        assert package.decode(b"#ADL;7;ab\n", "request") == dial  # without the checksum
+        assert package.encode(package.decode(b"#ADL;7;ab\n", "request")) == b"#ADL;7;ab\n"
+        assert package.encode(package.AnswerResponse(talker="A", ok=package.Side.NORTH)).startswith(b"#AOK;N!")
+        sum_without = (~sum(b"ADL;7;ab")) & 0xFF  # the separator is covered: one over the fields alone fails
+        with pytest.raises(DecodeError, match="does not match"):
+            package.decode(b"#ADL;7;ab;!%02X\n" % sum_without, "request")
+        for cls in package.MESSAGE_TYPES:
+            frames, messages = random_frames(package, cls, 10)
+            parser = package.StreamParser(cls.DIRECTION.value)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages

@@ -7,7 +7,6 @@ checksum (`checksum: {directions: [request]}`): `ok`, `ok T:201.3 /202.0 B:117.0
 from __future__ import annotations
 
 import importlib
-import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -20,11 +19,9 @@ SPEC = Path(__file__).parent / "specs" / "marlin.yaml"
 
 @pytest.fixture(scope="module")
 def marlin(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
-    from conftest import generate_and_import
+    from conftest import generate_afresh
 
-    for name in [m for m in sys.modules if m.partition(".")[0] == "marlin"]:
-        del sys.modules[name]
-    return generate_and_import(SPEC, tmp_path_factory.mktemp("marlin"), "marlin")
+    return generate_afresh(SPEC, tmp_path_factory, "marlin")
 
 
 def test_the_documented_lines_decode_and_encode_byte_for_byte(marlin: ModuleType) -> None:

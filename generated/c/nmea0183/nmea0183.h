@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "8c113e761e43b506c1c2b6c498c0ecfe2d67644feb6191d315543563f2a55295"
+#define NMEA0183_SPEC_SHA256 "16a6093993cec0e472cfc5afb44fb23dc8ce8988be90e2222d81e59850ba8af3"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE
@@ -281,11 +281,13 @@ typedef enum {
 } nmea0183_kind_t;
 
 /* One message: its kind, the frame-level talker, how many fields the frame had after the address (-1: every
- * declared one; encode writes that many, so a decoded sentence encodes to the same text) and its fields. */
+ * declared one; encode writes that many, so a decoded sentence encodes to the same text), whether it came without
+ * its optional checksum (encode then writes none) and its fields. */
 typedef struct {
     nmea0183_kind_t kind;
     char talker[3];
     int32_t sent;
+    bool unchecked; /* sent without its optional checksum: encode leaves it out too */
     union {
         nmea0183_gga_response_t gga_response;
         nmea0183_rmc_response_t rmc_response;

@@ -100,8 +100,8 @@ def readable(result: dict[str, Any]) -> str:
 
 
 def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_hex: bool) -> int:
-    """The JSON object decode --json prints (fields as their texts; talker and sent may be left out) -> the frame,
-    as text (without its line ending) or as hex."""
+    """The JSON object decode --json prints (fields as their texts; talker, sent and checksum_ok may be left out)
+    -> the frame, as text (without its line ending) or as hex."""
     framing: TextFraming = package.FRAMING
     command = data["command"]
     cls = next(
@@ -122,7 +122,9 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
         values = from_texts(framing.sentence(cls.CODE, cls.DIRECTION.value), fields)
     except DecodeError as exc:
         raise EncodeError(str(exc)) from None
-    frame = framing.encode(cls.CODE, values, talker, sent, cls.DIRECTION.value)
+    # what decode --json says of a frame sent without its optional checksum (`"checksum_ok": null`) leaves it out
+    unchecked = "checksum_ok" in data and data["checksum_ok"] is None and not framing.required
+    frame = framing.encode(cls.CODE, values, talker, sent, cls.DIRECTION.value, unchecked)
     if as_hex:
         print(frame.hex(" "))
     else:

@@ -512,7 +512,8 @@ _FIELD_LONG: dict[str, Shape] = {
     "inferred": TEXT,
     "precision": Int(
         "text decimal, angle, time: fraction digits written for a value that does not carry its own (a float; a "
-        "decoded value keeps the digits it was sent with).",
+        "decoded value keeps the digits it was sent with); a decimal without one writes a float in its shortest "
+        "form (2.5, never rounded to 2).",
         minimum=0,
         example=4,
     ),
@@ -1200,6 +1201,14 @@ FRAMING = Obj(
                     "some sentences).",
                     default=True,
                     example=False,
+                ),
+                "separated": ListOf(
+                    Str(choices=("request", "response")),
+                    "The directions whose frames write the separator between the last field and the marker, "
+                    "covered by the checksum (ODrive's documented request `r vbus_voltage *93`; its replies, "
+                    "`12.5*48`, do not: `separated: [request]`); decode also takes such a frame without it. The C "
+                    "target and the Wireshark dissector refuse it, saying so.",
+                    example=["request"],
                 ),
                 "directions": ListOf(
                     Str(choices=("request", "response")),

@@ -21,7 +21,7 @@ from enum import Enum
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, RangeError, shown
 from serialspec.runtime.message import Direction
-from serialspec.runtime.values import asdict, dataclass, field, fields
+from serialspec.runtime.values import asdict, dataclass, field, fields, replace
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
@@ -175,6 +175,7 @@ class Sentence:
     values: dict[str, Any]
     sent: int = -1  # fields after the address (-1: every declared field)
     direction: str = "response"
+    unchecked: bool = False  # sent without its (optional) checksum: encoding it again leaves the checksum out
 
 
 @dataclass(frozen=True)
@@ -200,6 +201,7 @@ class TextFraming:
     max_length: int = 82
     decimal: bool = False  # the checksum written in decimal (G-code: `N1 G28*18`), not as `digits` hex digits
     checksummed: tuple[str, ...] = ("request", "response")  # the directions whose frames carry the checksum
+    separated: tuple[str, ...] = ()  # the directions whose frames write the separator before the checksum's marker
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
@@ -230,6 +232,9 @@ class TextFraming:
         if len(found) == 1:  # the code says the direction (an answer-only code read by a request parser too)
             return next(iter(found.values()))
         if direction is None:
+            coded = [s for s in found.values() if not s.bare]
+            if len(coded) == 1:  # beside a reply of values alone, which never starts with its code
+                return coded[0]
             raise DirectionNeeded(code)
         return found[direction]
 
@@ -247,7 +252,7 @@ class TextFraming:
             raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
         body = text[len(self.start) :]
         if self.checksum is None or len(self.checksummed) == 2:
-            return self._decode_body(self._checked(body), direction, reply)
+            return self._decode_checked(body, direction, reply)
         # a checksum in one direction only: a frame of the other is all text (its fields may hold the marker)
         if direction is not None and direction not in self.checksummed:
             return self._decode_body(body, direction, reply)
@@ -258,7 +263,16 @@ class TextFraming:
                 whole = None
             if whole is not None and whole.direction not in self.checksummed:
                 return whole
-        return self._decode_body(self._checked(body), direction, reply)
+        return self._decode_checked(body, direction, reply)
+
+    def _decode_checked(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """A frame of a direction that carries the checksum; one sent without it (where it may be left out) says so,
+        so that it encodes again without it."""
+        covered = self._checked(body, direction)
+        sentence = self._decode_body(covered, direction, reply)
+        if self.checksum is not None and covered == body:
+            return replace(sentence, unchecked=True)
+        return sentence
 
     def _decode_body(self, body: str, direction: str | None, reply: str | None) -> Sentence:
         """The text between start and checksum (the checksum checked) -> its sentence."""
@@ -337,12 +351,20 @@ class TextFraming:
             values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
         return Sentence(talker, code, values, -1, sentence.direction)
 
-    def _checked(self, body: str, required: bool = True) -> str:
+    def _checked(self, body: str, direction: str | None) -> str:
+        """The text before the checksum, the checksum checked (and the separator before its marker taken off, in a
+        direction that writes one there)."""
+        covered = self._covered(body)
+        if covered != body and self.separated and direction in (None, *self.separated):
+            return covered.removesuffix(self.separator)
+        return covered
+
+    def _covered(self, body: str) -> str:
         if self.checksum is None:
             return body
         at = body.rfind(self.marker)
         if at < 0:
-            if self.required and required:
+            if self.required:
                 raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
             return body
         written, covered = body[at + len(self.marker) :], body[:at]
@@ -362,7 +384,13 @@ class TextFraming:
     # --- encoding --------------------------------------------------------------------------------------------------
 
     def encode(
-        self, code: str, values: Mapping[str, Any], talker: str = "", sent: int = -1, direction: str | None = None
+        self,
+        code: str,
+        values: Mapping[str, Any],
+        talker: str = "",
+        sent: int = -1,
+        direction: str | None = None,
+        unchecked: bool = False,
     ) -> bytes:
         """A sentence's values -> the frame; EncodeError (RangeError) names the field at fault before any text is
         written. `sent` is the number of fields to write (a decoded Sentence's); -1 writes every declared one."""
@@ -378,25 +406,31 @@ class TextFraming:
             raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
         if sentence.layout is not None:
             inner = _encode_in(sentence, sentence.layout, values, talker + code, self._forbidden(sentence.direction))
-            return self.frame(inner, sentence.direction)
+            return self.frame(inner, sentence.direction, unchecked)
         parts = _encode_fields(sentence, values, self._forbidden(sentence.direction))
         if sent >= 0:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
             parts = (parts + [""] * sent)[:sent]
         body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
-        return self.frame(body, sentence.direction)
+        return self.frame(body, sentence.direction, unchecked)
 
-    def frame(self, body: str, direction: str | None = None) -> bytes:
-        """The text between start and checksum marker, framed (with its checksum where `direction` has one)."""
+    def frame(self, body: str, direction: str | None = None, unchecked: bool = False) -> bytes:
+        """The text between start and checksum marker, framed (with its checksum where `direction` has one, unless
+        `unchecked`: left out, where the framing lets it be)."""
         text = self.start + body
-        if self.checksum is not None and (direction is None or direction in self.checksummed):
+        written = not (unchecked and not self.required)
+        if self.checksum is not None and written and (direction is None or direction in self.checksummed):
+            if direction in self.separated:  # ODrive's `r vbus_voltage *93`: covered with the rest
+                text, body = text + self.separator, body + self.separator
             value = self.checksum(body.encode("ascii"))
             text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
         return (text + self.end).encode("ascii")
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
-        return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction)
+        return self.encode(
+            sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction, sentence.unchecked
+        )
 
     def _forbidden(self, direction: str) -> str:
         """The framing's own characters, which no field of a frame in `direction` may hold (the checksum's marker
@@ -649,7 +683,7 @@ def _put_decimal(spec: TextField, value: Any, where: str) -> str:
     number = _number(spec, value, where)
     if isinstance(value, Fixed):
         return _padded(format(number, "f"), value.width)
-    if isinstance(value, Decimal):
+    if isinstance(value, Decimal) or not spec.precision:  # a float with no precision: its shortest form, unrounded
         return _padded(format(number, "f"), spec.width)
     return _padded(f"{number:.{spec.precision}f}", spec.width)
 
@@ -917,12 +951,13 @@ class TextRecord:
     FRAMING: ClassVar[TextFraming]
     talker: str
     sent: int
+    # `unchecked` (a class of a framing whose checksum may be left out): sent without it, encoded again without it
 
     def to_fields(self) -> dict[str, Any]:
-        """The field values by name (groups as dicts), without talker and sent."""
+        """The field values by name (groups as dicts), without talker, sent and unchecked."""
         values = {}
         for f in fields(self):  # type: ignore[arg-type]
-            if f.name in ("talker", "sent"):
+            if f.name in ("talker", "sent", "unchecked"):
                 continue
             value = getattr(self, f.name)
             if f.name in self.GROUPS:
@@ -931,7 +966,7 @@ class TextRecord:
         return values
 
     @classmethod
-    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> Any:
+    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1, unchecked: bool = False) -> Any:
         known = {f.name for f in fields(cls)}  # type: ignore[arg-type]
         unknown = set(values) - known
         if unknown:
@@ -940,16 +975,22 @@ class TextRecord:
         # talker and sent may come with the values (a simulator builds a message from all its attributes)
         talker = str(given.pop("talker", None) or talker)
         sent = int(given.pop("sent", sent))
+        unchecked = bool(given.pop("unchecked", unchecked))
         for name, group in cls.GROUPS.items():
             if name in given:
                 given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
         if talker:
             given["talker"] = talker
+        if unchecked:
+            if "unchecked" not in known:
+                raise EncodeError(f"{cls.CODE}: its checksum cannot be left out")
+            given["unchecked"] = True
         factory: Any = cls  # a generated value class: its fields are keyword arguments
         return factory(**given, sent=sent)
 
     def encode(self) -> bytes:
-        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent, self.DIRECTION.value)
+        unchecked = bool(getattr(self, "unchecked", False))
+        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent, self.DIRECTION.value, unchecked)
 
 
 class TextCodec:
@@ -976,7 +1017,7 @@ class TextCodec:
 
     def message(self, sentence: Sentence) -> Any:
         cls = self.classes[sentence.code, sentence.direction]
-        return cls.from_fields(sentence.values, sentence.talker, sentence.sent)
+        return cls.from_fields(sentence.values, sentence.talker, sentence.sent, sentence.unchecked)
 
     def decode(self, frame: bytes | str, direction: str | None = None, expect: Any = None, request: Any = None) -> Any:
         """One frame -> its message; DecodeError (ChecksumError) says in one line why not. `direction` ("request"

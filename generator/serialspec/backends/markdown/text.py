@@ -27,7 +27,7 @@ def _shown(characters: str) -> str:
 def _kind(f: TextField) -> str:
     match f.kind:
         case "decimal":
-            written = f"{f.precision} decimal{'s' if f.precision != 1 else ''}" + (
+            written = (f"{f.precision} decimal{'s' if f.precision != 1 else ''}" if f.precision else "as given") + (
                 f", {f.width} integer digits" if f.width else ""
             )
             return f"decimal ({written})"
@@ -128,6 +128,9 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         optional = "" if frame.required else "; optional: a frame without it is accepted unchecked"
         if frame.checksum_directions != ("request", "response"):
             optional += f"; {' and '.join(d + 's' for d in frame.checksum_directions)} only"
+        if frame.checksum_separated:
+            names = " and ".join(d + "s" for d in frame.checksum_separated)
+            optional += f"; {names} write {code_span(frame.separator)} before the marker, covered by it"
         match frame.checksum_format:
             case "hex2":
                 written = f"{frame.digits} hex digits"

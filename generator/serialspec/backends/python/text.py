@@ -251,6 +251,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         yield "    decimal=True,"
     if text.checksum is not None and text.checksum_directions != ("request", "response"):
         yield f"    checksummed={text.checksum_directions!r},"
+    if text.checksum is not None and text.checksum_separated:
+        yield f"    separated={text.checksum_separated!r},"
     yield f"    required={text.required},"
     yield f"    talker={text.talker},"
     yield f"    talkers={text.talkers!r},"
@@ -328,6 +330,9 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
                 yield from _attribute(item)
         yield "    #: How many fields the frame had (a decoded message encodes to the same text); -1: every field."
         yield "    sent: int = field(default=-1, compare=False, repr=False)"
+        if text.checksum is not None and not text.required and message.direction.value in text.checksum_directions:
+            yield "    #: Sent without its checksum (which may be left out): encoded again without it."
+            yield "    unchecked: bool = field(default=False, compare=False, repr=False)"
     yield ""
     yield ""
     names = ", ".join(m.class_name for m in text.messages)

@@ -27,6 +27,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("a text checksum written in decimal (`format: decimal`)")
     if text.checksum is not None and text.checksum_directions != ("request", "response"):
         raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
+    if text.checksum is not None and text.checksum_separated:
+        raise Unsupported("a separator before the text checksum (`checksum.separated`)")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

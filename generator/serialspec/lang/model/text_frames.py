@@ -134,6 +134,7 @@ class TextFrame:
     device: TextDevice | None = None
     checksum_format: Literal["hex2", "decimal"] = "hex2"  # how the checksum is written after the marker
     checksum_directions: tuple[str, ...] = ("request", "response")  # the directions whose frames carry it
+    checksum_separated: tuple[str, ...] = ()  # the directions that write the separator before the marker
 
     def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
         """The command's message in `direction` (its response by default: what a device sends)."""

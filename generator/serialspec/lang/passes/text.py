@@ -125,7 +125,9 @@ class TextPass(Pass):
         required = True
         written: Literal["hex2", "decimal"] = "hex2"
         carried: tuple[str, ...] = ("request", "response")
+        separated: tuple[str, ...] = ()
         if isinstance(checksum_raw, dict):
+            separated = tuple(d for d in ("request", "response") if d in (checksum_raw.get("separated") or ()))
             if checksum_raw.get("directions"):
                 carried = tuple(d for d in ("request", "response") if d in checksum_raw["directions"])
             marker = str(checksum_raw.get("marker", "*"))
@@ -162,6 +164,7 @@ class TextPass(Pass):
             messages=(),
             checksum_format=written,
             checksum_directions=carried,
+            checksum_separated=separated,
         )
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:

@@ -1937,3 +1937,34 @@ def test_an_optional_text_checksum_after_a_separator_through_every_output() -> N
             frames, messages = random_frames(package, cls, 10)
             parser = package.StreamParser(cls.DIRECTION.value)
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_starts_by_direction_and_an_address_before_the_code_through_every_output() -> None:
+    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): C and
+    Wireshark refuse them in one line; the reference shows both starts; the start says the direction; every message
+    carries the address first, its digits before the talker and code; random messages round trip, among each other
+    in a stream of both directions; the simulator answers with the request's address."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["start"] = {"request": "#", "response": "$"}
+    case["framing"]["address"] = "unit"
+    case["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
+    files = python_and_markdown(case, r"^a start of its own for each direction \(`start: \{request: \.\.\., response")
+    assert "| start | `#` or `$` | starts a request or a response |" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        asked = package.DialRequest(unit=12, talker="A", level=7, note="hi")
+        frame = package.encode(asked)
+        assert frame.startswith(b"#12ADL;7;hi!") and package.decode(frame) == asked  # no direction needed
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        [(_, answer)] = device.feed(frame)
+        assert answer.startswith(b"$12ADL;7;") and package.decode(answer).unit == 12, answer
+        frames, messages = b"", []
+        for cls in package.MESSAGE_TYPES:
+            more, decoded = random_frames(package, cls, 10)
+            frames, messages = frames + more, messages + decoded
+        parser = package.StreamParser()
+        assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+    refused = copy.deepcopy(case)
+    refused["framing"]["address"] = "side"
+    with pytest.raises(SpecErrors, match=r"framing\.address: the address 'side' is an integer field"):
+        resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))

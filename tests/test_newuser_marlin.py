@@ -11,28 +11,17 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-import yaml
+from conftest import package_fixture, text_examples_round_trip
 from serialspec.runtime.errors import ChecksumError, DeviceError
 
 SPEC = Path(__file__).parent / "specs" / "marlin.yaml"
 
-
-@pytest.fixture(scope="module")
-def marlin(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
-    from conftest import generate_afresh
-
-    return generate_afresh(SPEC, tmp_path_factory, "marlin")
+marlin = package_fixture(SPEC, "marlin")
 
 
 def test_the_documented_lines_decode_and_encode_byte_for_byte(marlin: ModuleType) -> None:
     """Each example: its printed line decodes to the documented values and encodes back to the same characters."""
-    examples = yaml.safe_load(SPEC.read_text("utf-8"))["examples"]
-    assert len(examples) == 5
-    for name, example in examples.items():
-        frame = example["printed"].encode() + b"\n"
-        message = marlin.decode(frame, example["direction"])
-        assert example["command"] == message.COMMAND, name
-        assert marlin.encode(message) == frame, name
+    assert text_examples_round_trip(marlin, SPEC, b"\n") == 5
     move = marlin.decode(b"N123 G1 X10.5 Y-3*45\n")
     assert (move.number, move.command, [w.word for w in move.words]) == (123, "G1", ["X10.5", "Y-3"])
     built = marlin.LineRequest(number=0, command="M106")

@@ -12,30 +12,18 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-import yaml
+from conftest import package_fixture, text_examples_round_trip
 from serialspec.runtime.errors import ChecksumError
 
 SPEC = Path(__file__).parent / "specs" / "odrive_ascii.yaml"
 
-
-@pytest.fixture(scope="module")
-def odrive(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
-    from conftest import generate_afresh
-
-    return generate_afresh(SPEC, tmp_path_factory, "odrive_ascii")
+odrive = package_fixture(SPEC, "odrive_ascii")
 
 
 def test_the_documented_lines_decode_and_encode_byte_for_byte(odrive: ModuleType) -> None:
     """Each documented example decodes to its values and encodes back to the same characters: with the checksum
     after a space where the docs print one, without a checksum where they print none."""
-    examples = yaml.safe_load(SPEC.read_text("utf-8"))["examples"]
-    assert len(examples) == 5
-    for name, example in examples.items():
-        frame = example["printed"].encode() + b"\n"
-        message = odrive.decode(frame, "request")
-        assert example["command"] == message.COMMAND, name
-        assert {k: str(v) for k, v in message.to_fields().items()} == example["fields"], name
-        assert odrive.encode(message) == frame, name
+    assert text_examples_round_trip(odrive, SPEC, b"\n", "request") == 5
     assert odrive.decode(b"q 0 -2 1 0.1\n").torque_lim == Decimal("0.1")  # `q` names the request alone
 
 

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "16a6093993cec0e472cfc5afb44fb23dc8ce8988be90e2222d81e59850ba8af3"
+#define NMEA0183_SPEC_SHA256 "829a62b151d0ee94617dcc8b84246da8d6674b157dd2652ad4770c91c4b9218c"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

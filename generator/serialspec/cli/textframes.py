@@ -19,7 +19,7 @@ def frame_of(framing: TextFraming, given: str) -> bytes:
     """A frame given on the command line: as typed (starting with the start character; the line ending may be
     left out, or written as \\r\\n) or as hex."""
     text = given.strip()
-    if text.startswith(framing.start):
+    if text.startswith((framing.start, framing.response_start or framing.start)):
         text = text.replace("\\r", "\r").replace("\\n", "\n")
         try:
             return text.encode("ascii")

@@ -1171,9 +1171,22 @@ FRAMING = Obj(
             default="binary",
             example="text",
         ),
-        "start": Str(
+        "start": OneOf(
+            (
+                Str(),
+                Obj(
+                    {
+                        "request": Str("The requests' start (`#`).", example="#"),
+                        "response": Str("The responses' start (`*`).", example="*"),
+                    },
+                    required=("request", "response"),
+                ),
+            ),
             "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
-            "line ending) and the stream parser resynchronises at the next line ending.",
+            "line ending) and the stream parser resynchronises at the next line ending. A mapping gives each "
+            'direction its own (Lynxmotion LSS: `start: {request: "#", response: "*"}`, `#5QD` asked and '
+            "`*5QD1800` answered): a frame's start then says its direction. The C target and the Wireshark "
+            "dissector refuse starts that differ by direction, saying so.",
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),
@@ -1236,6 +1249,14 @@ FRAMING = Obj(
                 "text: a frame-level value at the start of the first field, before the text code (NMEA's talker "
                 "id: GP in $GPGGA); every message carries it as `talker`."
             ),
+        ),
+        "address": Str(
+            "text: a shared integer field (its name in `fields:`) that every message carries first, its digits "
+            "written right after the start and before the talker and code, with nothing between (Lynxmotion LSS's "
+            "servo id: `address: id` reads `#5D1800` as id 5, code D, 1800). Messages, JSON and client methods have "
+            "it as a field; the simulator answers with the request's. The C target and the Wireshark dissector "
+            "refuse it, saying so.",
+            example="id",
         ),
         "max_length": Int(
             "text: the longest frame in characters, start to checksum (NMEA 0183: 82 with the line ending): the "

@@ -111,6 +111,7 @@ class TextField:
     maximum: float | None = None
     letters: type[Enum] | None = None
     label: str = ""  # in a message with its own layout (TextLayout.named): the label its value follows
+    address: bool = False  # every message's first field, its digits right after the start, before the code (LSS's id)
 
 
 @dataclass(frozen=True)
@@ -202,12 +203,15 @@ class TextFraming:
     decimal: bool = False  # the checksum written in decimal (G-code: `N1 G28*18`), not as `digits` hex digits
     checksummed: tuple[str, ...] = ("request", "response")  # the directions whose frames carry the checksum
     separated: tuple[str, ...] = ()  # the directions whose frames write the separator before the checksum's marker
+    response_start: str = ""  # the responses' own start, where it differs from the requests' (`start`): LSS's `*`
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
     layouts: tuple[TextLayout, ...] = field(init=False, repr=False, compare=False)  # the messages' own, each once
     # the messages found by their code alone (their own text without a start), the longest code first
     alone: tuple[TextSentence, ...] = field(init=False, repr=False, compare=False)
+    # every message's first field where it is an address written before the code (LSS's servo id), else None
+    address: TextField | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         by_code: dict[str, dict[str, TextSentence]] = {}
@@ -218,6 +222,8 @@ class TextFraming:
         object.__setattr__(self, "layouts", tuple(layouts))
         alone = [s for s in self.sentences if s.layout is not None and not s.layout.start]
         object.__setattr__(self, "alone", tuple(sorted(alone, key=lambda s: -len(s.code))))
+        firsts = [s.fields[0] for s in self.sentences if s.fields]
+        object.__setattr__(self, "address", next((f for f in firsts if isinstance(f, TextField) and f.address), None))
 
     def sentence(self, code: str, direction: str | None = None, asked: bool = False) -> TextSentence:
         """The message a code names, in `direction` where the code names one each way; DecodeError where there is
@@ -248,7 +254,16 @@ class TextFraming:
         text = _ascii(frame)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
-        if not text.startswith(self.start):
+        if self.response_start:  # each direction its own start: the start says the direction
+            said = "response" if text.startswith(self.response_start) else "request"
+            start = self.start_of(said)
+            if not text.startswith(start) or direction not in (None, said):
+                wanted = f"{self.start!r} (a request) or {self.response_start!r} (a response)"
+                if direction is not None:
+                    wanted = repr(self.start_of(direction))
+                raise DecodeError(f"text frame does not start with {wanted}: {shown(text[:20])}")
+            direction = said
+        elif not text.startswith(self.start):
             raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
         body = text[len(self.start) :]
         if self.checksum is None or len(self.checksummed) == 2:
@@ -275,7 +290,19 @@ class TextFraming:
         return sentence
 
     def _decode_body(self, body: str, direction: str | None, reply: str | None) -> Sentence:
-        """The text between start and checksum (the checksum checked) -> its sentence."""
+        """The text between start and checksum (the checksum checked) -> its sentence; the address first, where
+        every message has one (its digits, right after the start)."""
+        if self.address is None:
+            return self._decode_rest(body, direction, reply)
+        digits = 0
+        while digits < len(body) and body[digits] in _DIGITS:
+            digits += 1
+        value = decode_field("address", self.address, body[:digits])
+        sentence = self._decode_rest(body[digits:], direction, reply)
+        return replace(sentence, values={self.address.name: value, **sentence.values})
+
+    def _decode_rest(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """The text after the address (all of it where the messages have none) -> its sentence."""
         for layout in self.layouts:
             if body.startswith(layout.start) and body[len(layout.start) :].endswith(layout.end):
                 return self._decode_in(layout, body[len(layout.start) : len(body) - len(layout.end)], direction)
@@ -404,21 +431,28 @@ class TextFraming:
         unknown = set(values) - {f.name for f in sentence.fields}
         if unknown:
             raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+        address = ""
+        if self.address is not None:  # its digits before everything else
+            address = encode_field(sentence.where, self.address, values.get(self.address.name))
         if sentence.layout is not None:
             inner = _encode_in(sentence, sentence.layout, values, talker + code, self._forbidden(sentence.direction))
-            return self.frame(inner, sentence.direction, unchecked)
+            return self.frame(address + inner, sentence.direction, unchecked)
         parts = _encode_fields(sentence, values, self._forbidden(sentence.direction))
         if sent >= 0:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
             parts = (parts + [""] * sent)[:sent]
         body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
-        return self.frame(body, sentence.direction, unchecked)
+        return self.frame(address + body, sentence.direction, unchecked)
+
+    def start_of(self, direction: str | None) -> str:
+        """The start of a frame in `direction` (the requests' where the responses have none of their own)."""
+        return self.response_start if direction == "response" and self.response_start else self.start
 
     def frame(self, body: str, direction: str | None = None, unchecked: bool = False) -> bytes:
         """The text between start and checksum marker, framed (with its checksum where `direction` has one, unless
         `unchecked`: left out, where the framing lets it be)."""
-        text = self.start + body
+        text = self.start_of(direction) + body
         written = not (unchecked and not self.required)
         if self.checksum is not None and written and (direction is None or direction in self.checksummed):
             if direction in self.separated:  # ODrive's `r vbus_voltage *93`: covered with the rest
@@ -436,7 +470,7 @@ class TextFraming:
         """The framing's own characters, which no field of a frame in `direction` may hold (the checksum's marker
         only where that direction carries a checksum)."""
         marker = self.marker if self.checksum is not None and direction in self.checksummed else ""
-        return "".join({self.start, self.separator, marker, *self.end} - {""})
+        return "".join({self.start, self.response_start, self.separator, marker, *self.end} - {""})
 
 
 # --- fields -------------------------------------------------------------------------------------------------------
@@ -459,8 +493,8 @@ def _split(text: str, by: str) -> list[str]:
 
 def _decode_labelled(sentence: TextSentence, layout: TextLayout, parts: list[str]) -> dict[str, Any]:
     """Fields found by their labels (`label` + `named` + value), in any order; an absent one is None (a repeat: [])."""
-    items = {item.label: item for item in sentence.fields}
-    values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in sentence.fields}
+    items = {item.label: item for item in _sent(sentence)}
+    values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in _sent(sentence)}
     seen: set[str] = set()
     for part in parts:
         label, found, text = part.partition(layout.named)
@@ -497,7 +531,7 @@ def _encode_in(
         {layout.start, layout.end, layout.separator, layout.named, layout.list, layout.after_code or ""} - {""}
     )
     parts = [address]
-    for item in sentence.fields:
+    for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
             text = encode_field(sentence.where, item, value, forbidden)
@@ -521,10 +555,16 @@ def _encode_in(
     return layout.start + parts[0] + fields + layout.end
 
 
+def _sent(sentence: TextSentence) -> tuple[TextField | TextRepeat, ...]:
+    """The fields written after the code: all but an address (written before it)."""
+    first = sentence.fields[0] if sentence.fields else None
+    return sentence.fields[1:] if isinstance(first, TextField) and first.address else sentence.fields
+
+
 def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:
     values: dict[str, Any] = {}
     at = 0
-    for item in sentence.fields:
+    for item in _sent(sentence):
         if isinstance(item, TextField):
             values[item.name] = decode_field(sentence.where, item, parts[at] if at < len(parts) else "")
             at += 1
@@ -632,7 +672,7 @@ def _looks(spec: TextField) -> str:
 
 def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str) -> list[str]:
     parts: list[str] = []
-    for item in sentence.fields:
+    for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
             parts.append(encode_field(sentence.where, item, value, forbidden))
@@ -831,6 +871,8 @@ class TextStreamParser:
         self._awaited: str | None = None  # the code of the reply awaited (expect), where it is values alone
         self._overlong = False  # frames without a start character: the line being read was dropped as too long
         self._start = framing.start.encode("ascii")
+        # every start a frame may have (one character each where the directions have their own)
+        self._starts = tuple(s.encode("ascii") for s in dict.fromkeys((framing.start, framing.response_start)) if s)
         self._end = framing.end.encode("ascii")
         self._buffer = b""
         self.corrupt = 0
@@ -843,13 +885,13 @@ class TextStreamParser:
         if not self._start:
             return self._lines(found, limit)
         while True:
-            start = self._buffer.find(self._start)
+            start = self._find_start(0)
             if start < 0:
                 self._buffer = self._buffer[-(len(self._start) - 1) :] if len(self._start) > 1 else b""
                 return found
             self._buffer = self._buffer[start:]
             end = self._buffer.find(self._end, len(self._start))
-            restart = self._buffer.find(self._start, len(self._start))
+            restart = self._find_start(len(self._start))
             if end < 0 or (0 <= restart < end):
                 if restart >= 0 and (end < 0 or restart < end):
                     self._dropped("text frame cut short by a new start")
@@ -865,6 +907,13 @@ class TextStreamParser:
                 found.append(self._decoded(frame))
             except DecodeError as error:
                 self._dropped(str(error))
+
+    def _find_start(self, at: int) -> int:
+        """Where the first start at or after `at` is in the buffer, or -1."""
+        if len(self._starts) == 1:
+            return self._buffer.find(self._start, at)
+        found = [i for i in (self._buffer.find(s, at) for s in self._starts) if i >= 0]
+        return min(found, default=-1)
 
     def _lines(self, found: list[Sentence], limit: int) -> list[Sentence]:
         """Frames without a start character: each line is a frame. A line that grows past `max_length` is dropped
@@ -922,7 +971,7 @@ class TextStreamParser:
     def gap(self) -> None:
         """The line went idle: no frame spans it. A frame begun (its start character read; frames without one: a line
         with more than blanks) is dropped as cut short, counted in `corrupt`; the line ending that follows is noise."""
-        begun = self._buffer.startswith(self._start) if self._start else bool(self._buffer.strip(b"\r\n"))
+        begun = self._buffer.startswith(self._starts) if self._start else bool(self._buffer.strip(b"\r\n"))
         if begun and not self._overlong:
             self._dropped("text frame cut short by a gap in the line")
         self._buffer, self._overlong = b"", False

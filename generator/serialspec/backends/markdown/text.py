@@ -118,7 +118,11 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         yield ""
     yield "| part | characters | meaning |"
     yield "| --- | --- | --- |"
-    yield f"| start | {code_span(frame.start)} | starts every frame |"
+    if frame.response_start:
+        starts = f"{code_span(frame.start)} or {code_span(frame.response_start)}"
+        yield f"| start | {starts} | starts a request or a response |"
+    else:
+        yield f"| start | {code_span(frame.start)} | starts every frame |"
     if frame.talker:
         talkers = ", ".join(frame.talkers) or "any"
         yield f"| talker | {frame.talker} characters | {cell(frame.talker_description)} ({talkers}) |"
@@ -213,6 +217,7 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
 def _characters(frame: TextFrame, printed: str, fields: dict[str, object], bare: bool = False) -> Iterator[str]:
     """The printed frame cut into its parts: start, talker, code, each field, checksum, end (`bare`: a reply of
     values alone, its first part the first field)."""
+    start = printed[: len(frame.start)]  # the requests' or the responses' own
     body = printed[len(frame.start) :]
     checksum = ""
     if frame.checksum is not None and frame.marker in body:
@@ -220,7 +225,7 @@ def _characters(frame: TextFrame, printed: str, fields: dict[str, object], bare:
     parts = body.split(frame.separator)
     if bare:
         parts = ["", *parts]  # no code: the first part is a field's, written without a separator before it
-    yield f"| {code_span(frame.start)} | start |"
+    yield f"| {code_span(start)} | start |"
     if frame.talker and not bare:
         yield f"| {code_span(parts[0][: frame.talker])} | talker |"
     if not bare:

@@ -159,6 +159,8 @@ def _descriptor(f: TextField) -> str:
         arguments.append(f"letters={f.letters_class}")
     if f.label:
         arguments.append(f"label={f.label!r}")
+    if f.address:
+        arguments.append("address=True")
     return f"TextField({', '.join(arguments)})"
 
 
@@ -242,6 +244,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield "#: The frame: start, talker and code, fields, checksum, line ending."
     yield "FRAMING = TextFraming("
     yield f"    start={text.start!r},"
+    if text.response_start:
+        yield f"    response_start={text.response_start!r},"
     yield f"    separator={text.separator!r},"
     yield f"    end={text.end!r},"
     yield f"    checksum={checksum},"

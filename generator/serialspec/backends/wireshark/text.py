@@ -29,6 +29,10 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
     if text.checksum is not None and text.checksum_separated:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")
+    if text.response_start:
+        raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
+    if text.address is not None:
+        raise Unsupported("an address before the text code (`framing.address`)")
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

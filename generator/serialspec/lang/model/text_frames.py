@@ -27,6 +27,7 @@ class TextField:
     letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
     letters_class: str = ""  # char with letters: the generated Enum's name
     label: str = ""  # in a message with its own text layout (`named`): the label its value follows
+    address: bool = False  # the framing's `address`: every message's first field, written before the code
 
 
 @frozen
@@ -135,6 +136,8 @@ class TextFrame:
     checksum_format: Literal["hex2", "decimal"] = "hex2"  # how the checksum is written after the marker
     checksum_directions: tuple[str, ...] = ("request", "response")  # the directions whose frames carry it
     checksum_separated: tuple[str, ...] = ()  # the directions that write the separator before the marker
+    response_start: str = ""  # the responses' own start where it differs from the requests' (`start`): LSS's `*`
+    address: TextField | None = None  # every message's first field, its digits before the code (LSS's servo id)
 
     def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
         """The command's message in `direction` (its response by default: what a device sends)."""

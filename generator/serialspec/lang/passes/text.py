@@ -43,7 +43,7 @@ KIND_KEYS = {
 }
 COMMON_KEYS = {"type", "use", "description", "unit", "label"}
 BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
-TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
+TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length", "address")
 NOT_YET = ("matching", "enums", "flags", "tables", "errata")
 # What a text device may say (the binary device's memory, ids, models and behaviours are not available yet)
 DEVICE_KEYS = ("description", "state", "reply", "sends", "commands")
@@ -115,9 +115,14 @@ class TextPass(Pass):
         for key in ("separator", "end"):
             if not raw.get(key):
                 self.error(path, f"missing key {key!r} (a text frame needs `separator` and `end`)")
-        start = str(raw.get("start") or "")  # none: every line is a frame
+        given = raw.get("start") or ""  # none: every line is a frame
+        start, response_start = str(given), ""
+        if isinstance(given, dict):  # one per direction: LSS's `#` requests and `*` replies
+            start, response_start = str(given.get("request") or ""), str(given.get("response") or "")
+            if not start or not response_start or start == response_start:
+                self.error((*path, "start"), "give each direction its own start, two different characters")
         separator, end = (str(raw.get(k) or "?") for k in ("separator", "end"))
-        if len(start) > 1 or len(separator) != 1:
+        if len(start) > 1 or len(response_start) > 1 or len(separator) != 1:
             self.error(path, "`start` (when given) and `separator` must be one character each")
         checksum_raw = raw.get("checksum")
         algorithm = None
@@ -146,7 +151,8 @@ class TextPass(Pass):
         for index, value in enumerate(talkers):
             if len(value) != size:
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
-        special = [*([start] if start else []), separator, *set(end)] + ([marker] if algorithm is not None else [])
+        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *set(end)]
+        special += [marker] if algorithm is not None else []
         if len(set(special)) != len(special):
             self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
         return TextFrame(
@@ -165,7 +171,25 @@ class TextPass(Pass):
             checksum_format=written,
             checksum_directions=carried,
             checksum_separated=separated,
+            response_start=response_start,
+            address=self.address(raw["address"]) if "address" in raw else None,
         )
+
+    def address(self, name: Any) -> TextField | None:
+        """`framing.address`: the shared integer field every message carries first, before its code."""
+        path: Path = ("framing", "address")
+        if str(name) not in self.shared_fields:
+            self.error(path, f"no shared field {name!r} in `fields:`")
+            return None
+        found = self.guard(path, self.field, str(name), str(name), path, True)
+        if found is None:
+            return None
+        if not isinstance(found, TextField) or found.kind != "integer":
+            self.error(path, f"the address {name!r} is an integer field (its digits are read before the code)")
+            return None
+        if found.minimum is not None and found.minimum < 0:
+            self.error(path, f"the address {name!r} is written as digits alone: its range starts at 0 or above")
+        return replace(found, address=True)
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
         path: Path = ("commands", key)
@@ -174,7 +198,11 @@ class TextPass(Pass):
                 self.error((*path, bad), f"`{bad}` is not available in text frames yet")
         code = command.get("code")
         # the framing's own characters would cut the code out of its frame (`$` starts NMEA sentences)
-        framing = {frame.start, frame.separator, frame.marker, *frame.end} - {""} if frame is not None else set()
+        framing = (
+            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end} - {""}
+            if frame is not None
+            else set()
+        )
         allowed = set(CODE_CHARACTERS) - framing
         if not isinstance(code, str) or not code or not set(code) <= allowed:
             shown = "".join(sorted(set(CODE_PUNCTUATION) - framing))
@@ -201,6 +229,10 @@ class TextPass(Pass):
                 f"{key} has a response of its own: leave out `answered_by` or the response",
             )
         fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
+        if frame is not None and frame.address is not None:  # every message's first field, before its code
+            if any(item.name == frame.address.name for item in fields):
+                self.error((*where, "fields", frame.address.name), "the framing's `address` is every message's already")
+            fields = (frame.address, *fields)
         layout = (
             self.layout(raw["text"], code, fields, (*where, "text"), frame)
             if "text" in raw and isinstance(raw["text"], dict)
@@ -247,7 +279,8 @@ class TextPass(Pass):
             if layout is None or layout.start:
                 continue
             after = layout.separator if layout.after_code is None else layout.after_code
-            first = message.fields[0] if message.fields else None
+            sent = [f for f in message.fields if not (isinstance(f, TextField) and f.address)]
+            first = sent[0] if sent else None
             numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal")
             for other in sorted(codes):
                 if other == message.code or not other.startswith(message.code + after):
@@ -270,7 +303,7 @@ class TextPass(Pass):
         frame: TextFrame | None,
     ) -> TextLayout:
         """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
-        framing = {frame.start, frame.marker, *frame.end} - {""} if frame is not None else set()
+        framing = {frame.start, frame.response_start, frame.marker, *frame.end} - {""} if frame is not None else set()
         given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
         given.setdefault("separator", frame.separator if frame is not None else ",")
         layout = TextLayout(**given)
@@ -521,6 +554,13 @@ class TextPass(Pass):
                 else:
                     echoes.append(str(name))
             found.append(TextAnswer(str(key), str(item.get("description", "")), stores, sets, reports, tuple(echoes)))
+        if frame.address is not None:  # every answer carries the request's address (the servo asked answers)
+            name = frame.address.name
+            found = [replace(a, echoes=(name, *a.echoes)) if name not in a.echoes else a for a in found]
+            entries = {a.command for a in found}
+            for request in frame.messages:
+                if request.direction == Direction.REQUEST and request.key not in entries and frame.answer(request):
+                    found.append(TextAnswer(request.key, echoes=(name,)))
         return tuple(found)
 
     def examples(self, frame: TextFrame) -> list[TextExample]:

@@ -39,7 +39,7 @@ def describe(
     framing: TextFraming = package.FRAMING
     sentence = framing.decode(frame, direction, reply)
     cls = package.CODEC.classes[sentence.code, sentence.direction]
-    body = frame.decode("ascii")
+    body = frame.decode("latin-1")  # ASCII, its line ending perhaps not
     return {
         "protocol": protocol,
         "direction": cls.DIRECTION.value,
@@ -128,5 +128,5 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
     if as_hex:
         print(frame.hex(" "))
     else:
-        print(frame.decode("ascii").removesuffix(framing.end))
+        print(frame.decode("latin-1").removesuffix(framing.end))
     return 0

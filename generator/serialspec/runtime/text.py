@@ -251,7 +251,7 @@ class TextFraming:
         `direction` is needed only for a code that names a request and a response. `reply`: the code of the reply
         awaited (the answer to the request before this frame; given, the request is known): where that reply is its
         values alone (`bare`), a frame that does not start with another message's code is read as it."""
-        text = _ascii(frame)
+        text = _ascii(frame, self.end)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
         if self.response_start:  # each direction its own start: the start says the direction
@@ -459,7 +459,7 @@ class TextFraming:
                 text, body = text + self.separator, body + self.separator
             value = self.checksum(body.encode("ascii"))
             text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
-        return (text + self.end).encode("ascii")
+        return (text + self.end).encode("latin-1")  # the line ending may hold bytes above 0x7F (Nextion's FF FF FF)
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
         return self.encode(
@@ -847,13 +847,16 @@ def _field_text(sentence: TextSentence, name: str, given: Any) -> str:
     return given if isinstance(given, str) else str(given)
 
 
-def _ascii(frame: bytes | str) -> str:
+def _ascii(frame: bytes | str, end: str = "") -> str:
+    """A frame's characters: ASCII, but for a line ending `end` that may hold bytes above 0x7F (Nextion's FF FF FF),
+    each such byte a character of the same number."""
     if isinstance(frame, str):
         return frame
-    try:
-        return bytes(frame).decode("ascii")
-    except UnicodeDecodeError as error:
-        raise DecodeError(f"text frame holds a non-ASCII byte {frame[error.start]:02X}") from None
+    text = bytes(frame).decode("latin-1")
+    body = text[: -len(end)] if end and text.endswith(end) else text
+    if bad := next((c for c in body if c > "\x7f"), None):
+        raise DecodeError(f"text frame holds a non-ASCII byte {ord(bad):02X}")
+    return text
 
 
 # --- the stream parser --------------------------------------------------------------------------------------------
@@ -873,7 +876,7 @@ class TextStreamParser:
         self._start = framing.start.encode("ascii")
         # every start a frame may have (one character each where the directions have their own)
         self._starts = tuple(s.encode("ascii") for s in dict.fromkeys((framing.start, framing.response_start)) if s)
-        self._end = framing.end.encode("ascii")
+        self._end = framing.end.encode("latin-1")
         self._buffer = b""
         self.corrupt = 0
         self.last_error = ""

@@ -34,6 +34,8 @@ def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
     if not text.start:
         raise Unsupported("text frames without a start character (every line a frame)")
+    if any(c > "\x7f" for c in text.end):
+        raise Unsupported("a line ending with bytes above 0x7F (`end`)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
     if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message

@@ -151,6 +151,10 @@ class TextPass(Pass):
         for index, value in enumerate(talkers):
             if len(value) != size:
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
+        if any(not " " <= c <= "~" for c in (start, response_start, separator) if c):
+            self.error(path, "`start` and `separator` are printable ASCII characters")
+        if any(c > "\xff" for c in end):
+            self.error((*path, "end"), "the line ending's characters are bytes: U+0000 to U+00FF (Nextion: \\xFF)")
         special = [*([start] if start else []), *([response_start] if response_start else []), separator, *set(end)]
         special += [marker] if algorithm is not None else []
         if len(set(special)) != len(special):

@@ -332,7 +332,7 @@ def text_examples_round_trip(package: ModuleType, spec: Path, end: bytes, direct
         frame = example["printed"].encode() + end
         message = package.decode(frame, direction)
         assert (example["command"], example["direction"]) == (message.COMMAND, message.DIRECTION.value), name
-        shown = {k: v if isinstance(v, tuple) else str(v) for k, v in message.to_fields().items()}
+        shown = {k: v if isinstance(v, tuple) else "" if v is None else str(v) for k, v in message.to_fields().items()}
         wanted = {k: v if isinstance(v, list) else str(v) for k, v in example["fields"].items()}
         assert shown.keys() == wanted.keys() and all(
             shown[k] == wanted[k] for k in shown if not isinstance(wanted[k], list)

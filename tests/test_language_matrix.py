@@ -1781,6 +1781,17 @@ def random_frames(package: ModuleType, cls: Any, count: int) -> tuple[bytes, lis
     return frames, messages
 
 
+def streams_back(package: ModuleType, classes: tuple[Any, ...], direction: str | None) -> None:
+    """Random messages of these classes round trip (random_frames), and a stream of all of them among garbage, fed
+    byte by byte, gives them back in order."""
+    frames, messages = b"", []
+    for cls in classes:
+        more, decoded = random_frames(package, cls, 10)
+        frames, messages = frames + more, messages + decoded
+    parser = package.StreamParser(direction)
+    assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
 def python_and_markdown(case: dict[str, Any], refused: str) -> dict[str, str]:
     """A text case's files from every output but C and Wireshark (each verified), which refuse it in one line."""
     from serialspec.backends import Unsupported
@@ -1857,12 +1868,7 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
         assert package.decode(package.encode(glued)) == glued
         assert package.decode(package.encode(package.GluedResponse(talker="A"))) == package.GluedResponse(talker="A")
         assert package.encode(package.PairsResponse.from_fields({"vals": [{"v": 1}]}, "B")).startswith(b"#BPR=1:!")
-        frames, messages = b"", []
-        for cls in (package.GluedResponse, package.LongerResponse, package.PairsResponse):
-            more, decoded = random_frames(package, cls, 10)
-            frames, messages = frames + more, messages + decoded
-        parser = package.StreamParser("response")
-        assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+        streams_back(package, (package.GluedResponse, package.LongerResponse, package.PairsResponse), "response")
     for change, expected in (
         ({"longer": {"code": "GL5"}}, "the code 'GL' then '' begins the code 'GL5': a frame could be either"),
         ({"glued": {"response": {"fields": {"n": "text"}}}}, "the code 'GL' then '' begins the code 'GLX'"),
@@ -1968,3 +1974,54 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
     refused["framing"]["address"] = "side"
     with pytest.raises(SpecErrors, match=r"framing\.address: the address 'side' is an integer field"):
         resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
+
+
+def test_labels_glued_to_their_values_through_every_output() -> None:
+    """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's
+    `D1800T1500`, the first value labelled with the code): C and Wireshark refuse them in one line; the reference
+    says how they are written; random messages round trip and stream; what a frame could not tell apart is refused."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["move"] = {
+        "code": "MV",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": "", "separator": ""},
+            "fields": {
+                "at": {"label": "MV", "type": "integer"},
+                "time": {"label": "T", "type": "integer"},
+                "speed": {"label": "SD", "type": "decimal"},
+            },
+        },
+    }
+    case["commands"]["words"] = {
+        "code": "GW",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": ""},
+            "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
+        },
+    }
+    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    assert "written as its label glued to its value" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        move = package.MoveResponse(talker="A", at=-15, time=1500)
+        assert package.encode(move).startswith(b"#AMV-15T1500!") and package.decode(package.encode(move)) == move
+        words = package.WordsResponse(talker="A", x=10.5, y=-3)
+        assert package.encode(words).startswith(b"#AGW;X10.5;Y-3!")
+        reordered = package.FRAMING.frame("AGW;Y-3;X10.5", "response")
+        assert package.decode(reordered) == package.decode(package.encode(words))  # in any order
+        streams_back(package, (package.MoveResponse, package.WordsResponse, package.AnswerResponse), "response")
+    for command, field, change, expected in (
+        ("move", "time", {"label": "SDX"}, "label 'SD' begins another label"),
+        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a number"),
+        ("words", "y", {"label": "X1"}, "label 'X' begins another label"),
+    ):
+        broken = copy.deepcopy(case)
+        broken["commands"][command]["response"]["fields"][field].update(change)
+        with pytest.raises(SpecErrors, match=expected):
+            resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+    broken = copy.deepcopy(case)
+    broken["commands"]["words"]["response"]["text"]["start"] = "<"
+    with pytest.raises(SpecErrors, match="need a message found by its code"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))

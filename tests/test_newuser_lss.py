@@ -22,7 +22,7 @@ lss = package_fixture(SPEC, "lynxmotion_lss")
 
 def test_the_documented_lines_decode_and_encode_byte_for_byte(lss: ModuleType) -> None:
     """Each example decodes, without its direction (the start says it), to its values and encodes back."""
-    assert text_examples_round_trip(lss, SPEC, b"\r") == 6
+    assert text_examples_round_trip(lss, SPEC, b"\r") == 7
     assert lss.decode(b"*5QD-150\r") == lss.QueryPositionResponse(id=5, position=-150)
     assert lss.encode(lss.MoveRequest(id=254, position=-900)) == b"#254D-900\r"
     assert lss.decode(b"*12Q6\r") == lss.QueryStatusResponse(id=12, status=6)  # Q beside QD: the longest code fits
@@ -58,13 +58,12 @@ def test_a_client_moves_and_queries_the_simulated_servo(lss: ModuleType) -> None
     ]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=DecodeError,
-    reason="language gap: modifiers after a command's value, each a letter glued to its own value with nothing "
-    "between (`#5D1800T1500`: move in 1500 ms; `SD`, `CH`): labelled fields need `text.named`, one character between "
-    "a label and its value, and a separator between fields; labels glued to their values and to each other are not "
-    "in the language",
-)
-def test_a_move_with_a_timed_modifier(lss: ModuleType) -> None:
-    lss.decode(b"#5D1800T1500\r")
+def test_modifiers_glued_after_the_value(lss: ModuleType) -> None:
+    """`#5D1800T1500` (a move in 1500 ms): labels glued to their values with nothing between (`text: {named: "",
+    separator: ""}`), the position labelled with the code itself; a strict xfail until this was in the language."""
+    timed = lss.decode(b"#5D1800T1500\r")
+    assert timed == lss.MoveRequest(id=5, position=1800, time=1500)
+    assert lss.encode(timed) == b"#5D1800T1500\r"
+    assert lss.decode(b"#5D-50SD200\r") == lss.MoveRequest(id=5, position=-50, speed=200)
+    with pytest.raises(DecodeError, match="unknown label"):
+        lss.decode(b"#5D1800X3\r")

@@ -578,7 +578,8 @@ TEXT_LAYOUT = Obj(
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
         "separator": Str(
-            "One character between the code and the fields, and between fields (`|`); default the framing's.",
+            "One character between the code and the fields, and between fields (`|`); default the framing's. "
+            'Empty with labels glued to their values (`named: ""`): nothing between them.',
             example="|",
         ),
         "after_code": Str(
@@ -591,7 +592,11 @@ TEXT_LAYOUT = Obj(
         ),
         "named": Str(
             "One character between a field's `label` and its value (`:`): every field has a label and is found "
-            "by it, in any order.",
+            'by it, in any order. Empty (`named: ""`) glues each label to its value, in a message found by its '
+            "code (no `start`): G-code's `G1 X10.5 Y-3` (`code: G1`, `x: {label: X, type: decimal}`); with "
+            '`separator: ""` too, the values are numbers, each ending where a label begins (Lynxmotion LSS\'s '
+            "`D1800T1500`: `position: {label: D}` labelled with the code, right after it, then `time: {label: "
+            "T}`). No label may begin another.",
             example=":",
         ),
         "list": Str(

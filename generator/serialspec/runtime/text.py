@@ -139,6 +139,12 @@ class TextLayout:
     named: str = ""
     list: str = ""
     after_code: str | None = None  # between the code and the first field (None: the separator; "": glued: `D1800`)
+    glued: bool = False  # labels glued to their values (`named: ""`): G-code's `X10.5`, LSS's `D1800T1500`
+
+    @property
+    def labelled(self) -> bool:
+        """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
+        return bool(self.named) or self.glued
 
 
 @dataclass(frozen=True)
@@ -339,6 +345,8 @@ class TextFraming:
                 break
             rest = text[len(sentence.code) :]
             after = layout.separator if layout.after_code is None else layout.after_code
+            if layout.glued and any(item.label == sentence.code for item in _sent(sentence)):
+                after = ""  # the value labelled with the code follows it (LSS's `D1800`)
             if not rest:
                 matched.append((sentence, None))
             elif rest.startswith(after) and rest.endswith(layout.end):
@@ -350,6 +358,12 @@ class TextFraming:
         sentence, inner = matched[0]
         layout = sentence.layout
         assert layout is not None  # every message in `alone` has its own text
+        if layout.glued:  # the code is the label of the value right after it, where a field has it as its label
+            own = any(item.label == sentence.code for item in _sent(sentence))
+            values = _labelled_values(
+                sentence, layout, _glued(sentence, layout, (sentence.code if own else "") + (inner or ""))
+            )
+            return Sentence(talker, sentence.code, values, -1, sentence.direction)
         texts = inner.split(layout.separator) if inner else []  # the code alone: no fields
         if layout.named:
             values = _decode_labelled(sentence, layout, texts)
@@ -480,6 +494,7 @@ class TextFraming:
 # (str.isdecimal: any Unicode decimal digit, as int() and Decimal() read them).
 _HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
 _DIGITS = frozenset("0123456789")
+_NUMBER = frozenset("0123456789+-.")  # what a number glued between labels may hold
 
 
 def _unsigned(text: str) -> str:
@@ -491,13 +506,44 @@ def _split(text: str, by: str) -> list[str]:
     return text.split(by) if by else [text]
 
 
+def _glued(sentence: TextSentence, layout: TextLayout, text: str) -> list[tuple[str, str, bool]]:
+    """(label, value, found) of each labelled value glued to its label (`named: ""`): the longest label a piece
+    starts with; without a separator, a value is the run of number characters after its label (`D1800T1500`)."""
+    labels = sorted((item.label for item in _sent(sentence)), key=len, reverse=True)
+    found: list[tuple[str, str, bool]] = []
+    if layout.separator:
+        for piece in text.split(layout.separator) if text else ():
+            label = next((lb for lb in labels if piece.startswith(lb)), None)
+            found.append((label, piece[len(label) :], True) if label is not None else (piece, "", False))
+        return found
+    at = 0
+    while at < len(text):
+        label = next((lb for lb in labels if text.startswith(lb, at)), None)
+        if label is None:
+            return [*found, (text[at:], "", False)]
+        end = at + len(label)
+        while end < len(text) and text[end] in _NUMBER:
+            end += 1
+        found.append((label, text[at + len(label) : end], True))
+        at = end
+    return found
+
+
 def _decode_labelled(sentence: TextSentence, layout: TextLayout, parts: list[str]) -> dict[str, Any]:
     """Fields found by their labels (`label` + `named` + value), in any order; an absent one is None (a repeat: [])."""
+    pairs = (
+        _glued(sentence, layout, layout.separator.join(parts))
+        if layout.glued
+        else [(lb, text, bool(found)) for lb, found, text in (p.partition(layout.named) for p in parts)]
+    )
+    return _labelled_values(sentence, layout, pairs)
+
+
+def _labelled_values(sentence: TextSentence, layout: TextLayout, pairs: list[tuple[str, str, bool]]) -> dict[str, Any]:
     items = {item.label: item for item in _sent(sentence)}
     values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in _sent(sentence)}
     seen: set[str] = set()
-    for part in parts:
-        label, found, text = part.partition(layout.named)
+    for label, text, found in pairs:
         item = items.get(label)
         if not found or item is None:
             expected = ", ".join(items) or "none"
@@ -535,19 +581,19 @@ def _encode_in(
         value = values.get(item.name)
         if isinstance(item, TextField):
             text = encode_field(sentence.where, item, value, forbidden)
-            if layout.named and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
+            if layout.labelled and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
                 parts[0] += f"{layout.named}{text}" if value is not None else ""
-            elif value is not None or not layout.named:
-                parts.append(f"{item.label}{layout.named}{text}" if layout.named else text)
+            elif value is not None or not layout.labelled:
+                parts.append(f"{item.label}{layout.named}{text}" if layout.labelled else text)
             continue
-        if not value and layout.named:
+        if not value and layout.labelled:
             continue  # an absent label
         single = TextSentence(sentence.code, (item,), sentence.where)
         texts = _encode_fields(single, {item.name: value}, forbidden)
         if not texts:
             continue  # a repeat of no groups (at the end, `max_count`): nothing, not an empty field
         joined = (layout.list or layout.separator).join(texts)
-        parts.append(f"{item.label}{layout.named}{joined}" if layout.named else joined)
+        parts.append(f"{item.label}{layout.named}{joined}" if layout.labelled else joined)
     after = layout.separator if layout.after_code is None else layout.after_code
     joined = layout.separator.join(parts[1:])
     # found by its code alone: a frame whose fields have no text is the code alone

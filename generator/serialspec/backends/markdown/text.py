@@ -53,8 +53,12 @@ def _range(f: TextField) -> str:
 
 def _layout_text(layout: TextLayout) -> str:
     """A message's own text layout (`text:`), in words."""
-    fields = f"each field after {code_span(layout.separator)}"
-    if layout.named:
+    fields = (
+        f"each field after {code_span(layout.separator)}" if layout.separator else "each field right after the last"
+    )
+    if layout.glued:
+        fields += ", written as its label glued to its value and found by its label in any order (a label absent: None)"
+    elif layout.named:
         fields += (
             f", written as its label, {code_span(layout.named)} and its value and found by its label in any order "
             "(a label absent: None)"
@@ -83,8 +87,9 @@ def _rows(message: TextMessage) -> Iterator[str]:
     index = 1
     for item in message.fields:
         # by position, or by label in a message's own text with `named`
-        first = code_span(item.label + layout.named) if layout is not None and layout.named else str(index)
-        if layout is not None and layout.named and item.label == message.code:
+        labelled = layout is not None and layout.labelled
+        first = code_span(item.label + (layout.named if layout else "")) if labelled else str(index)
+        if labelled and item.label == message.code:
             first += ", right after the code"  # the code's own value (GRBL's `Hold:0`)
         if isinstance(item, TextRepeat):
             times = f"{item.count} times" if item.count else f"up to {item.max_count} times, at the end"

@@ -283,6 +283,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
             shown = ", ".join(
                 f"{k}={getattr(message.layout, k)!r}" for k in keys if getattr(message.layout, k) is not None
             )
+            shown += ", glued=True" if message.layout.glued else ""
             yield f"            layout=TextLayout({shown}),"
         if message.values_only:
             yield "            bare=True,"

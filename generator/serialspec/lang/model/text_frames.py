@@ -53,6 +53,12 @@ class TextLayout:
     named: str = ""
     list: str = ""
     after_code: str | None = None  # between the code and the first field (None: the separator; "": glued)
+    glued: bool = False  # labels glued to their values (`named: ""`): G-code's `X10.5`, LSS's `D1800T1500`
+
+    @property
+    def labelled(self) -> bool:
+        """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
+        return bool(self.named) or self.glued
 
 
 @frozen

@@ -310,13 +310,17 @@ class TextPass(Pass):
         framing = {frame.start, frame.response_start, frame.marker, *frame.end} - {""} if frame is not None else set()
         given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
         given.setdefault("separator", frame.separator if frame is not None else ",")
-        layout = TextLayout(**given)
+        glued = given.get("named") == ""  # labels glued to their values: G-code's `X10.5`, LSS's `D1800T1500`
+        layout = TextLayout(**given, glued=glued)
+        fields = tuple(f for f in fields if not (isinstance(f, TextField) and f.address))  # the address: before
         if layout.start and layout.start[0] in CODE_CHARACTERS:
             self.error((*path, "start"), "a message's text starts with a character no text code has (GRBL: `<`)")
         for key in ("separator", "named", "list"):
             value = getattr(layout, key)
-            if key in raw and len(value) != 1:
+            if key in raw and len(value) != 1 and not (glued and key in ("named", "separator") and value == ""):
                 self.error((*path, key), f"`{key}` is one character")
+        if glued:
+            self.glued(layout, code, fields, path)
         if layout.after_code is not None and len(layout.after_code) > 1:
             self.error((*path, "after_code"), "`after_code` is one character, or empty (the value glued to the code)")
         single = [c for c in (layout.separator, layout.named, layout.list) if c]
@@ -326,11 +330,11 @@ class TextPass(Pass):
             self.error((*path, "after_code"), "`after_code` differs from the framing's characters")
         if set(code) & set(single + [layout.after_code or ""]) - {""}:
             self.error(path, f"the code {code!r} holds one of the message's own characters")
-        if not layout.start and any(item.label == code for item in fields):
+        if not layout.start and not glued and any(item.label == code for item in fields):
             self.error(path, "a field labelled with the code needs the message's own `start`")
         for item in fields:
             where = (*path[:-1], "fields", item.name)
-            if layout.named and not item.label:
+            if layout.labelled and not item.label:
                 self.error(where, "with `text.named` every field needs a `label`")
             if isinstance(item, TextRepeat) and layout.named and not layout.list:
                 self.error(where, "a labelled repeat needs `text.list` between its values")
@@ -345,6 +349,24 @@ class TextPass(Pass):
             if set(label) & set(single) or not label.isprintable() or " " in label:
                 self.error((*path[:-1], "fields"), f"label {label!r} holds a character the message's text uses")
         return layout
+
+    def glued(self, layout: TextLayout, code: str, fields: tuple[TextField | TextRepeat, ...], path: Path) -> None:
+        """Labels glued to their values (`named: ""`): a message found by its code, each value told by its label
+        (the longest that fits), and without a separator each value a number (it ends where a label begins)."""
+        if layout.start:
+            self.error((*path, "named"), 'labels glued to their values (`named: ""`) need a message found by its code')
+        labels = [item.label for item in fields if item.label]
+        for item in fields:
+            where = (*path[:-1], "fields", item.name)
+            if isinstance(item, TextRepeat):
+                self.error(where, 'a repeat in a message whose labels are glued to their values (`named: ""`)')
+            elif not layout.separator and item.kind not in ("integer", "decimal"):
+                self.error(where, "without a separator, a value glued between labels is a number (integer, decimal)")
+        for label in labels:
+            if any(other != label and other.startswith(label) for other in labels):
+                self.error((*path[:-1], "fields"), f"label {label!r} begins another label: a value could follow either")
+            if not layout.separator and (not label or set(label) & set("0123456789+-.")):
+                self.error((*path[:-1], "fields"), f"label {label!r} holds a number's character: it could be a value")
 
     def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:
         found: list[TextField | TextRepeat] = []

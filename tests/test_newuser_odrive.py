@@ -2,7 +2,7 @@
 reply, `f 0` and `r vbus_voltage` answered by their values alone (`values_only`), an optional checksum in decimal
 (`checksum: {format: decimal, required: false}`) that the documented example `r vbus_voltage *93` writes after a
 space (`separated: [request]`), and a line sent without its checksum encoded again without it.
-tests/specs/odrive_ascii.yaml; the package is generated once."""
+tests/specs/odrive_v05.yaml; the package is generated once."""
 
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ import pytest
 from conftest import package_fixture, text_examples_round_trip
 from serialspec.runtime.errors import ChecksumError
 
-SPEC = Path(__file__).parent / "specs" / "odrive_ascii.yaml"
+SPEC = Path(__file__).parent / "specs" / "odrive_v05.yaml"
 
-odrive = package_fixture(SPEC, "odrive_ascii")
+odrive = package_fixture(SPEC, "odrive_v05")
 
 
 def test_the_documented_lines_decode_and_encode_byte_for_byte(odrive: ModuleType) -> None:
@@ -52,7 +52,7 @@ def test_replies_of_values_alone(odrive: ModuleType) -> None:
 def test_a_client_drives_the_simulated_odrive(odrive: ModuleType) -> None:
     """The generated client against the generated simulator, in this process: setpoints get no reply and are kept;
     feedback and reads come back as values alone."""
-    simulator = importlib.import_module("odrive_ascii.simulator").SIMULATOR()
+    simulator = importlib.import_module("odrive_v05.simulator").SIMULATOR()
     path = simulator.start()
     try:
         with odrive.Client(path) as client:

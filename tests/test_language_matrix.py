@@ -40,7 +40,7 @@ from serialspec.lang.loader import load_text
 from serialspec.lang.model import Direction, Message, Protocol, replies_by_request, reply_to
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.transport import Bus
 from serialspec.transforms import transforms
 from strategies import message_fields
@@ -1894,8 +1894,6 @@ def test_a_text_checksum_in_one_direction_through_every_output() -> None:
     """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C and
     Wireshark refuse it in one line; requests carry the checksum, responses none (a marker in one is text), with or
     without the direction given; random messages round trip, through the stream parser too."""
-    from serialspec.runtime.errors import EncodeError
-
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"]["directions"] = ["request"]
     files = python_and_markdown(case, r"^a text checksum in one direction only \(`checksum.directions`\)$")
@@ -2024,4 +2022,41 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
     broken = copy.deepcopy(case)
     broken["commands"]["words"]["response"]["text"]["start"] = "<"
     with pytest.raises(SpecErrors, match="need a message found by its code"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+
+
+def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
+    """A `text` field's `size: rest` (Marlin's `Error:checksum mismatch, Last Line: 122`): the rest of the line,
+    separators included, in a plain message and in one found by its code; C and Wireshark refuse it in one line; the
+    reference says so; round trips, with separators and the layout's own characters in the text; misplaced, refused."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["note"] = {
+        "code": "NT",
+        "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+    }
+    case["commands"]["error"] = {
+        "code": "ER",
+        "response": {
+            "unsolicited": True,
+            "text": {"after_code": "="},
+            "fields": {"msg": {"type": "text", "size": "rest"}},
+        },
+    }
+    files = python_and_markdown(case, r"^a text field to the end of the line \(`size: rest`\)$")
+    assert "text (the rest of the line, separators included)" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        note = package.NoteResponse(talker="A", n=3, msg="a;b = c;")
+        assert package.encode(note).startswith(b"#ANT;3;a;b = c;!") and package.decode(package.encode(note)) == note
+        error = package.ErrorResponse(talker="A", msg="bad=1; x")
+        assert package.encode(error).startswith(b"#AER=bad=1; x!") and package.decode(package.encode(error)) == error
+        with pytest.raises(EncodeError, match="holds '!'"):
+            package.encode(package.NoteResponse(talker="A", msg="a!b"))  # the checksum's marker: still the framing's
+        streams_back(package, (package.NoteResponse, package.ErrorResponse, package.AnswerResponse), "response")
+    broken = copy.deepcopy(case)
+    broken["commands"]["note"]["response"]["fields"] = {"msg": {"type": "text", "size": "rest"}, "n": "integer"}
+    with pytest.raises(SpecErrors, match=r"msg\.size: the rest of the line \(`size: rest`\) is the last field"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+    broken["commands"]["note"]["response"]["fields"] = {"msg": {"type": "text", "size": 4}}
+    with pytest.raises(SpecErrors, match="a text field's size is `rest`"):
         resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "829a62b151d0ee94617dcc8b84246da8d6674b157dd2652ad4770c91c4b9218c"
+#define NMEA0183_SPEC_SHA256 "49d21489ee28416a69659ee7d20bea04e55602e4e5fe0c128c625f4670808359"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -457,7 +457,9 @@ _FIELD_LONG: dict[str, Shape] = {
         "bytes, string: a number, `rest` (up to the end of the content) or the name of an earlier integer field, "
         "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "
         "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE); array: the earlier "
-        "field holding the array's size in bytes (Modbus byte_count)",
+        "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
+        "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
+        "mismatch, Last Line: 122` as one text); the C target and the Wireshark dissector refuse it, saying so.",
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str(

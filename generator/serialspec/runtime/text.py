@@ -112,6 +112,7 @@ class TextField:
     letters: type[Enum] | None = None
     label: str = ""  # in a message with its own layout (TextLayout.named): the label its value follows
     address: bool = False  # every message's first field, its digits right after the start, before the code (LSS's id)
+    rest: bool = False  # text: the rest of the line, separators included (`size: rest`: Marlin's `Error:...`)
 
 
 @dataclass(frozen=True)
@@ -322,10 +323,10 @@ class TextFraming:
         if reply is not None and direction != "request":
             bare = self.by_code.get(reply, {}).get("response")
             if bare is not None and bare.bare and not self._coded(code, direction):
-                return Sentence("", reply, _decode_fields(bare, parts), len(parts), "response")
+                return Sentence("", reply, _decode_fields(bare, parts, self.separator), _count(bare, parts), "response")
         sentence = self.sentence(code, direction, reply is not None)
-        values = _decode_fields(sentence, parts[1:])
-        return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
+        values = _decode_fields(sentence, parts[1:], self.separator)
+        return Sentence(talker, code, values, _count(sentence, parts[1:]), sentence.direction)
 
     def _plain(self, code: str, direction: str | None) -> bool:
         """Whether `code` is that of a message sent in the framing's own text (no layout of its own), in
@@ -368,7 +369,7 @@ class TextFraming:
         if layout.named:
             values = _decode_labelled(sentence, layout, texts)
         else:
-            values = _decode_fields(sentence, [t for p in texts for t in _split(p, layout.list)])
+            values = _decode_fields(sentence, [t for p in texts for t in _split(p, layout.list)], layout.separator)
         return Sentence(talker, sentence.code, values, -1, sentence.direction)
 
     def _coded(self, code: str, direction: str | None) -> bool:
@@ -389,7 +390,7 @@ class TextFraming:
         if layout.named:
             values = _decode_labelled(sentence, layout, [after, *parts[1:]] if after != code else parts[1:])
         else:
-            values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
+            values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)], layout.separator)
         return Sentence(talker, code, values, -1, sentence.direction)
 
     def _checked(self, body: str, direction: str | None) -> str:
@@ -449,9 +450,10 @@ class TextFraming:
         if self.address is not None:  # its digits before everything else
             address = encode_field(sentence.where, self.address, values.get(self.address.name))
         if sentence.layout is not None:
-            inner = _encode_in(sentence, sentence.layout, values, talker + code, self._forbidden(sentence.direction))
+            forbidden = self._forbidden(sentence.direction)
+            inner = _encode_in(sentence, sentence.layout, values, talker + code, forbidden, self.separator)
             return self.frame(address + inner, sentence.direction, unchecked)
-        parts = _encode_fields(sentence, values, self._forbidden(sentence.direction))
+        parts = _encode_fields(sentence, values, self._forbidden(sentence.direction), self.separator)
         if sent >= 0:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
@@ -569,7 +571,7 @@ def _labelled_values(sentence: TextSentence, layout: TextLayout, pairs: list[tup
 
 
 def _encode_in(
-    sentence: TextSentence, layout: TextLayout, values: Mapping[str, Any], address: str, forbidden: str
+    sentence: TextSentence, layout: TextLayout, values: Mapping[str, Any], address: str, forbidden: str, outer: str = ""
 ) -> str:
     """The text of a message in its own layout: start, address, fields (labelled ones only where they have a value),
     end."""
@@ -580,7 +582,11 @@ def _encode_in(
     for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
-            text = encode_field(sentence.where, item, value, forbidden)
+            allowed = forbidden
+            if item.rest:  # the rest of the line: the message's own characters too (not the framing's)
+                for own in (layout.separator, layout.after_code or "", outer):
+                    allowed = allowed.replace(own, "") if own else allowed
+            text = encode_field(sentence.where, item, value, allowed)
             if layout.labelled and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
                 parts[0] += f"{layout.named}{text}" if value is not None else ""
             elif value is not None or not layout.labelled:
@@ -607,13 +613,22 @@ def _sent(sentence: TextSentence) -> tuple[TextField | TextRepeat, ...]:
     return sentence.fields[1:] if isinstance(first, TextField) and first.address else sentence.fields
 
 
-def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:
+def _count(sentence: TextSentence, parts: list[str]) -> int:
+    """How many fields a frame of these parts had (a text to the end of the line, separators and all, is one)."""
+    fields = _sent(sentence)
+    if fields and isinstance(fields[-1], TextField) and fields[-1].rest:
+        return min(len(parts), len(fields))
+    return len(parts)
+
+
+def _decode_fields(sentence: TextSentence, parts: list[str], separator: str = "") -> dict[str, Any]:
     values: dict[str, Any] = {}
     at = 0
     for item in _sent(sentence):
         if isinstance(item, TextField):
-            values[item.name] = decode_field(sentence.where, item, parts[at] if at < len(parts) else "")
-            at += 1
+            text = separator.join(parts[at:]) if item.rest else parts[at] if at < len(parts) else ""
+            values[item.name] = decode_field(sentence.where, item, text)
+            at = max(at + 1, len(parts)) if item.rest else at + 1
             continue
         size = len(item.fields)
         groups = item.count or min(item.maximum, -(-(len(parts) - at) // size))
@@ -716,12 +731,15 @@ def _looks(spec: TextField) -> str:
             return f"a{'n' if spec.kind[0] in 'aeiou' else ''} {spec.kind}"
 
 
-def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str) -> list[str]:
+def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str, separator: str = "") -> list[str]:
     parts: list[str] = []
     for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
-            parts.append(encode_field(sentence.where, item, value, forbidden))
+            # a text to the end of the line may hold the separator (and nothing else of the framing's)
+            parts.append(
+                encode_field(sentence.where, item, value, forbidden.replace(separator, "") if item.rest else forbidden)
+            )
             continue
         rows = list(value or ())
         limit = item.count or item.maximum

@@ -41,6 +41,8 @@ def _kind(f: TextField) -> str:
             return "time (hhmmss" + ("." + "s" * f.precision if f.precision else "") + ")"
         case "date":
             return "date (ddmmyy)"
+        case "text" if f.rest:
+            return "text (the rest of the line, separators included)"
         case _:
             return f.kind
 

@@ -161,6 +161,8 @@ def _descriptor(f: TextField) -> str:
         arguments.append(f"label={f.label!r}")
     if f.address:
         arguments.append("address=True")
+    if f.rest:
+        arguments.append("rest=True")
     return f"TextField({', '.join(arguments)})"
 
 

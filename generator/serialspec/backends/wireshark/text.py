@@ -21,6 +21,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end):
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
+    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
+        raise Unsupported("a text field to the end of the line (`size: rest`)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
     if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message

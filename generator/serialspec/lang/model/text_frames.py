@@ -28,6 +28,7 @@ class TextField:
     letters_class: str = ""  # char with letters: the generated Enum's name
     label: str = ""  # in a message with its own text layout (`named`): the label its value follows
     address: bool = False  # the framing's `address`: every message's first field, written before the code
+    rest: bool = False  # text `size: rest`: the rest of the line, separators included (the last field)
 
 
 @frozen

@@ -37,7 +37,7 @@ KIND_KEYS = {
     "integer": {"width", "range"},
     "angle": {"precision", "width", "range"},
     "char": {"letters"},
-    "text": set(),
+    "text": {"size"},
     "time": {"precision"},
     "date": set(),
 }
@@ -340,6 +340,8 @@ class TextPass(Pass):
                 self.error(where, "a labelled repeat needs `text.list` between its values")
             if isinstance(item, TextRepeat) and any(f.label for f in item.fields):
                 self.error(where, "a label goes on the repeat, not on its fields")
+            if isinstance(item, TextField) and item.rest and (layout.labelled or layout.list):
+                self.error((*where, "size"), "the rest of the line in a message whose fields have labels or lists")
             if isinstance(item, TextRepeat) and item.label == code:
                 self.error((*where, "label"), "the field after the code (labelled with the code) is one value")
         labels = [item.label for item in fields if item.label]
@@ -377,6 +379,9 @@ class TextPass(Pass):
         variable = [i for i, f in enumerate(found) if isinstance(f, TextRepeat) and not f.count]
         if variable and variable[0] != len(found) - 1:
             self.error((*path, found[variable[0]].name), "a repeat with `max_count` must be the last field")
+        rest = [i for i, f in enumerate(found) if isinstance(f, TextField) and f.rest]
+        if rest and rest[0] != len(found) - 1:
+            self.error((*path, found[rest[0]].name, "size"), "the rest of the line (`size: rest`) is the last field")
         return tuple(found)
 
     def field(self, name: str, value: Any, path: Path, top: bool) -> TextField | TextRepeat:
@@ -439,7 +444,18 @@ class TextPass(Pass):
             letters=letters,
             letters_class=letters_class,
             label=str(spec.get("label", "")),
+            rest=self.rest(spec, path, top),
         )
+
+    def rest(self, spec: dict[str, Any], path: Path, top: bool) -> bool:
+        """A text field's `size: rest`: the rest of the line, separators included (the last field of a message)."""
+        if "size" not in spec:
+            return False
+        if spec["size"] != "rest":
+            self.error((*path, "size"), "a text field's size is `rest` (the rest of the line), or not given")
+        elif not top:
+            self.error((*path, "size"), "the rest of the line is a message's last field, not a repeat's")
+        return spec["size"] == "rest" and top
 
     def device(self, raw: dict[str, Any], frame: TextFrame) -> TextDevice:
         """`device:` the state, the values every sentence carries and the sentences sent on their own."""

@@ -323,6 +323,45 @@ def scratch_folder(prefix: str) -> Path:
     return Path(folder.name)
 
 
+def text_examples_round_trip(package: ModuleType, spec: Path, end: bytes, direction: str | None = None) -> int:
+    """Each of a text spec's examples: its printed line (with `end`) decodes to its command and its values (as
+    text) and encodes back to the same characters; how many there are."""
+    import yaml
+
+    examples = yaml.safe_load(spec.read_text("utf-8"))["examples"]
+    for name, example in examples.items():
+        frame = example["printed"].encode() + end
+        message = package.decode(frame, direction)
+        assert (example["command"], example["direction"]) == (message.COMMAND, message.DIRECTION.value), name
+        shown = {k: v if isinstance(v, tuple) else "" if v is None else str(v) for k, v in message.to_fields().items()}
+        wanted = {k: v if isinstance(v, list) else str(v) for k, v in example["fields"].items()}
+        assert shown.keys() == wanted.keys() and all(
+            shown[k] == wanted[k] for k in shown if not isinstance(wanted[k], list)
+        ), name
+        assert package.encode(message) == frame, name
+    return len(examples)
+
+
+def package_fixture(spec: Path, name: str) -> Any:
+    """A module fixture giving the package `name` generated once from `spec` (generate_afresh)."""
+
+    @pytest.fixture(scope="module")
+    def package(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+        return generate_afresh(spec, tmp_path_factory, name)
+
+    return package
+
+
+def generate_afresh(spec: Path, tmp_path_factory: pytest.TempPathFactory, name: str) -> ModuleType:
+    """The package `name` generated from `spec` into a new temporary folder and imported, any package of that name
+    imported before (another test's spec of the same protocol) forgotten first: a module fixture's one generation."""
+    import sys
+
+    for module in [m for m in sys.modules if m.partition(".")[0] == name]:
+        del sys.modules[module]
+    return generate_and_import(spec, tmp_path_factory.mktemp(name), name)
+
+
 def generate_and_import(spec: Path, out: Path, name: str) -> ModuleType:
     """`serialspec generate SPEC --out OUT`, then the package `name` imported from OUT (a spec of a test's own)."""
     import sys

@@ -45,3 +45,28 @@ def pty_pair() -> Iterator[tuple[str, str]]:
         thread.join(5)
         for fd in (first_controller, first_device, second_controller, second_device, stop_reader, stop_writer):
             os.close(fd)
+
+
+@contextmanager
+def answering_line(asked: bytes, answer: bytes) -> Iterator[str]:
+    """Yield a device path whose other side reads one line, checks that it is `asked` (its line ending included,
+    the last byte of `asked`), and writes `answer`: a device that answers a client's request as the test says."""
+    controller, device = os.openpty()
+    seen: list[bytes] = []
+
+    def reply() -> None:
+        line = b""
+        while not line.endswith(asked[-1:]):
+            line += os.read(controller, 64)
+        seen.append(line)
+        os.write(controller, answer)
+
+    thread = threading.Thread(target=reply, daemon=True)
+    thread.start()
+    try:
+        yield os.ttyname(device)
+    finally:
+        thread.join(5)
+        os.close(controller)
+        os.close(device)
+    assert seen == [asked], seen

@@ -48,7 +48,7 @@ from serialspec.lang.model import (
 )
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.transport import Bus
 from serialspec.transforms import transforms
 from strategies import message_fields
@@ -1779,8 +1779,6 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
     back)."""
     from serialspec.backends import emit
     from serialspec.lang.passes.text import KINDS
-    from serialspec.runtime.text import TextField, TextRepeat
-    from test_text_frames import sentence_values
 
     protocol = resolve(load_text(yaml.safe_dump(TEXT_CASE, sort_keys=False), "matrix_text.yaml"))
     assert protocol.text is not None
@@ -1805,16 +1803,7 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
     with imported("matrix_text", modules, "the language matrix") as package:
         for cls in package.MESSAGE_TYPES:
             direction = cls.DIRECTION.value
-            sentence = package.FRAMING.sentence(cls.CODE, direction)
-            assert all(isinstance(f, TextField | TextRepeat) for f in sentence.fields)
-            frames, messages = b"", []
-            for values in st_examples(sentence_values(sentence), 20):
-                message = cls.from_fields(values, talker="B")
-                frame = package.encode(message)
-                assert package.decode(frame, direction) == message
-                assert package.encode(package.decode(frame, direction)) == frame
-                frames += b"\x00garbage#\n" + frame
-                messages.append(message)
+            frames, messages = random_frames(package, cls, 20)
             parser = package.StreamParser(direction)
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
         # the device answers the request under its code, as `device.commands.dial` says
@@ -1928,3 +1917,304 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
         device = importlib.import_module("matrix_text.simulator").SIMULATOR()
         sent = [package.decode(frame, "response") for _, frame in device.due()]
         assert any(isinstance(m, package.ReportResponse) and m.lvl == 0 for m in sent), sent
+
+
+def random_frames(package: ModuleType, cls: Any, count: int) -> tuple[bytes, list[Any]]:
+    """`count` random messages of a text message class, each checked to round trip (decode, and encode again byte
+    for byte): their frames, each after some garbage, and the messages."""
+    from serialspec.runtime.text import TextField, TextRepeat
+    from test_text_frames import sentence_values
+
+    direction = cls.DIRECTION.value
+    sentence = package.FRAMING.sentence(cls.CODE, direction)
+    assert all(isinstance(f, TextField | TextRepeat) for f in sentence.fields)
+    frames, messages = b"", []
+    for values in st_examples(sentence_values(sentence), count):
+        message = cls.from_fields(values, talker="B")
+        frame = package.encode(message)
+        assert package.decode(frame, direction) == message, frame
+        assert package.encode(package.decode(frame, direction)) == frame
+        frames += b"\x00garbage#\n" + frame
+        messages.append(message)
+    return frames, messages
+
+
+def streams_back(package: ModuleType, classes: tuple[Any, ...], direction: str | None) -> None:
+    """Random messages of these classes round trip (random_frames), and a stream of all of them among garbage, fed
+    byte by byte, gives them back in order."""
+    frames, messages = b"", []
+    for cls in classes:
+        more, decoded = random_frames(package, cls, 10)
+        frames, messages = frames + more, messages + decoded
+    parser = package.StreamParser(direction)
+    assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def python_and_markdown(case: dict[str, Any], refused: str) -> dict[str, str]:
+    """A text case's files from every output but C and Wireshark (each verified), which refuse it in one line."""
+    from serialspec.backends import Unsupported
+
+    protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    files: dict[str, str] = {}
+    for emitter in emitters():
+        if emitter.name in ("c", "wireshark"):
+            with pytest.raises(Unsupported, match=refused):
+                emitter.files(protocol)
+            continue
+        emitted = emitter.files(protocol)
+        assert emitter.verify is None or emitter.verify(protocol, emitted) == []
+        files.update(emitted)
+    return files
+
+
+def test_a_decimal_text_checksum_through_every_output() -> None:
+    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): the C target and the dissector refuse it in one line;
+    the reference says how it is written; the package writes the checksum in decimal (no leading zeros), reads it
+    back, refuses a wrong one and random messages round trip, byte by byte through the stream parser too."""
+    from serialspec.runtime.errors import ChecksumError
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"] = {"algorithm": "xor", "format": "decimal", "marker": "!"}
+    files = python_and_markdown(case, r"^a text checksum written in decimal \(`format: decimal`\)$")
+    assert "`!` + its value in decimal digits (0 to 255)" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        frame = package.encode(package.AnswerResponse(talker="A", ok=package.Side.NORTH))
+        assert frame == b"#AOK;N!%d\n" % (ord("A") ^ ord("O") ^ ord("K") ^ ord(";") ^ ord("N")), frame
+        assert package.decode(frame) == package.AnswerResponse(talker="A", ok=package.Side.NORTH)
+        with pytest.raises(ChecksumError, match="checksum 7 does not match the frame's"):
+            package.decode(b"#AOK;N!7\n")
+        with pytest.raises(ChecksumError, match="is not a decimal number of 1 to 3 digits"):
+            package.decode(b"#AOK;N!1F\n")
+        for cls in package.MESSAGE_TYPES:
+            direction = cls.DIRECTION.value
+            frames, messages = random_frames(package, cls, 10)
+            for frame in frames.split(b"\x00garbage#\n")[1:]:
+                written = frame[frame.rindex(b"!") + 1 : -1]
+                assert written.isdigit() and (written == b"0" or not written.startswith(b"0")), frame
+            parser = package.StreamParser(direction)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_messages_found_by_their_code_alone_through_every_output() -> None:
+    """A message's own `text:` without a `start` (found by its code: Roboteq's `A=12:13`) and with `after_code`
+    (`""`: the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins:
+    C and Wireshark refuse it in one line; the reference says how it is written; random messages round trip and are
+    found byte by byte among the others; codes that a frame could not tell apart are refused, one line each."""
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["glued"] = {
+        "code": "GL",
+        "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
+    }
+    case["commands"]["longer"] = {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}}
+    case["commands"]["pairs"] = {
+        "code": "PR",
+        "response": {
+            "unsolicited": True,
+            "text": {"separator": "=", "list": ":"},
+            "fields": {"vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}}},
+        },
+    }
+    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    docs = files["docs/matrix_text.md"]
+    assert "found by its code: the code, the first field right after the code" in docs, docs
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        glued = package.GluedResponse(talker="A", n=-12)
+        assert package.encode(glued).startswith(b"#AGL-12!")
+        assert package.decode(package.encode(glued)) == glued
+        assert package.decode(package.encode(package.GluedResponse(talker="A"))) == package.GluedResponse(talker="A")
+        assert package.encode(package.PairsResponse.from_fields({"vals": [{"v": 1}]}, "B")).startswith(b"#BPR=1:!")
+        streams_back(package, (package.GluedResponse, package.LongerResponse, package.PairsResponse), "response")
+    for change, expected in (
+        ({"longer": {"code": "GL5"}}, "the code 'GL' then '' begins the code 'GL5': a frame could be either"),
+        ({"glued": {"response": {"fields": {"n": "text"}}}}, "the code 'GL' then '' begins the code 'GLX'"),
+        ({"pairs": {"response": {"text": {"after_code": "=="}}}}, "`after_code` is one character, or empty"),
+        ({"pairs": {"response": {"text": {"after_code": "!"}}}}, "`after_code` differs from the framing's"),
+    ):
+        broken = copy.deepcopy(case)
+        for command, keys in change.items():
+            target = broken["commands"][command]
+            for key, value in keys.items():
+                if isinstance(value, dict):
+                    for inner, item in value.items():
+                        target[key][inner] = {**target[key][inner], **item} if isinstance(item, dict) else item
+                else:
+                    target[key] = value
+        with pytest.raises(SpecErrors) as refused:
+            resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+        lines = str(refused.value).splitlines()
+        assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines
+
+
+def test_a_text_checksum_in_one_direction_through_every_output() -> None:
+    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C and
+    Wireshark refuse it in one line; requests carry the checksum, responses none (a marker in one is text), with or
+    without the direction given; random messages round trip, through the stream parser too."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"]["directions"] = ["request"]
+    files = python_and_markdown(case, r"^a text checksum in one direction only \(`checksum.directions`\)$")
+    assert "; requests only |" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        answer = package.AnswerResponse(talker="A", ok=package.Side.NORTH)
+        assert package.encode(answer) == b"#AOK;N\n"
+        assert package.decode(b"#AOK;N\n") == answer
+        dial = package.DialRequest(talker="A", level=7, note="ab")
+        assert package.encode(dial).startswith(b"#ADL;7;ab!")
+        assert package.decode(package.encode(dial), "request") == dial
+        with pytest.raises(EncodeError, match="holds '!', which a text frame cannot carry"):
+            package.encode(package.DialRequest(talker="A", level=7, note="a!b"))
+        reply = package.DialResponse(talker="A", level=7, note="x!y")
+        assert package.encode(reply) == b"#ADL;7;;;x!y\n"
+        assert package.decode(b"#ADL;7;;;x!y\n", "response") == reply
+        for cls in package.MESSAGE_TYPES:
+            direction = cls.DIRECTION.value
+            frames, messages = random_frames(package, cls, 10)
+            parser = package.StreamParser(direction)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_an_optional_text_checksum_after_a_separator_through_every_output() -> None:
+    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): C and Wireshark refuse
+    it in one line; requests write the separator before the marker, covered by the checksum, responses do not; a
+    frame sent without the checksum decodes and encodes again without it; random messages round trip."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["checksum"].update({"required": False, "separated": ["request"]})
+    files = python_and_markdown(case, r"^a separator before the text checksum \(`checksum.separated`\)$")
+    assert "requests write `;` before the marker, covered by it" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        dial = package.DialRequest(talker="A", level=7, note="ab")
+        frame = package.encode(dial)
+        assert frame.startswith(b"#ADL;7;ab;!") and package.decode(frame, "request") == dial
+        assert package.decode(b"#ADL;7;ab\n", "request") == dial  # without the checksum
+        assert package.encode(package.decode(b"#ADL;7;ab\n", "request")) == b"#ADL;7;ab\n"
+        assert package.encode(package.AnswerResponse(talker="A", ok=package.Side.NORTH)).startswith(b"#AOK;N!")
+        sum_without = (~sum(b"ADL;7;ab")) & 0xFF  # the separator is covered: one over the fields alone fails
+        with pytest.raises(DecodeError, match="does not match"):
+            package.decode(b"#ADL;7;ab;!%02X\n" % sum_without, "request")
+        for cls in package.MESSAGE_TYPES:
+            frames, messages = random_frames(package, cls, 10)
+            parser = package.StreamParser(cls.DIRECTION.value)
+            assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+
+
+def test_starts_by_direction_and_an_address_before_the_code_through_every_output() -> None:
+    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): C and
+    Wireshark refuse them in one line; the reference shows both starts; the start says the direction; every message
+    carries the address first, its digits before the talker and code; random messages round trip, among each other
+    in a stream of both directions; the simulator answers with the request's address."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["start"] = {"request": "#", "response": "$"}
+    case["framing"]["address"] = "unit"
+    case["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
+    files = python_and_markdown(case, r"^a start of its own for each direction \(`start: \{request: \.\.\., response")
+    assert "| start | `#` or `$` | starts a request or a response |" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        asked = package.DialRequest(unit=12, talker="A", level=7, note="hi")
+        frame = package.encode(asked)
+        assert frame.startswith(b"#12ADL;7;hi!") and package.decode(frame) == asked  # no direction needed
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        [(_, answer)] = device.feed(frame)
+        assert answer.startswith(b"$12ADL;7;") and package.decode(answer).unit == 12, answer
+        frames, messages = b"", []
+        for cls in package.MESSAGE_TYPES:
+            more, decoded = random_frames(package, cls, 10)
+            frames, messages = frames + more, messages + decoded
+        parser = package.StreamParser()
+        assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+    refused = copy.deepcopy(case)
+    refused["framing"]["address"] = "side"
+    with pytest.raises(SpecErrors, match=r"framing\.address: the address 'side' is an integer field"):
+        resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
+
+
+def test_labels_glued_to_their_values_through_every_output() -> None:
+    """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's
+    `D1800T1500`, the first value labelled with the code): C and Wireshark refuse them in one line; the reference
+    says how they are written; random messages round trip and stream; what a frame could not tell apart is refused."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["move"] = {
+        "code": "MV",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": "", "separator": ""},
+            "fields": {
+                "at": {"label": "MV", "type": "integer"},
+                "time": {"label": "T", "type": "integer"},
+                "speed": {"label": "SD", "type": "decimal"},
+            },
+        },
+    }
+    case["commands"]["words"] = {
+        "code": "GW",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": ""},
+            "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
+        },
+    }
+    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    assert "written as its label glued to its value" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        move = package.MoveResponse(talker="A", at=-15, time=1500)
+        assert package.encode(move).startswith(b"#AMV-15T1500!") and package.decode(package.encode(move)) == move
+        words = package.WordsResponse(talker="A", x=10.5, y=-3)
+        assert package.encode(words).startswith(b"#AGW;X10.5;Y-3!")
+        reordered = package.FRAMING.frame("AGW;Y-3;X10.5", "response")
+        assert package.decode(reordered) == package.decode(package.encode(words))  # in any order
+        streams_back(package, (package.MoveResponse, package.WordsResponse, package.AnswerResponse), "response")
+    for command, field, change, expected in (
+        ("move", "time", {"label": "SDX"}, "label 'SD' begins another label"),
+        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a number"),
+        ("words", "y", {"label": "X1"}, "label 'X' begins another label"),
+    ):
+        broken = copy.deepcopy(case)
+        broken["commands"][command]["response"]["fields"][field].update(change)
+        with pytest.raises(SpecErrors, match=expected):
+            resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+    broken = copy.deepcopy(case)
+    broken["commands"]["words"]["response"]["text"]["start"] = "<"
+    with pytest.raises(SpecErrors, match="need a message found by its code"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+
+
+def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
+    """A `text` field's `size: rest` (Marlin's `Error:checksum mismatch, Last Line: 122`): the rest of the line,
+    separators included, in a plain message and in one found by its code; C and Wireshark refuse it in one line; the
+    reference says so; round trips, with separators and the layout's own characters in the text; misplaced, refused."""
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["note"] = {
+        "code": "NT",
+        "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+    }
+    case["commands"]["error"] = {
+        "code": "ER",
+        "response": {
+            "unsolicited": True,
+            "text": {"after_code": "="},
+            "fields": {"msg": {"type": "text", "size": "rest"}},
+        },
+    }
+    files = python_and_markdown(case, r"^a text field to the end of the line \(`size: rest`\)$")
+    assert "text (the rest of the line, separators included)" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        note = package.NoteResponse(talker="A", n=3, msg="a;b = c;")
+        assert package.encode(note).startswith(b"#ANT;3;a;b = c;!") and package.decode(package.encode(note)) == note
+        error = package.ErrorResponse(talker="A", msg="bad=1; x")
+        assert package.encode(error).startswith(b"#AER=bad=1; x!") and package.decode(package.encode(error)) == error
+        with pytest.raises(EncodeError, match="holds '!'"):
+            package.encode(package.NoteResponse(talker="A", msg="a!b"))  # the checksum's marker: still the framing's
+        streams_back(package, (package.NoteResponse, package.ErrorResponse, package.AnswerResponse), "response")
+    broken = copy.deepcopy(case)
+    broken["commands"]["note"]["response"]["fields"] = {"msg": {"type": "text", "size": "rest"}, "n": "integer"}
+    with pytest.raises(SpecErrors, match=r"msg\.size: the rest of the line \(`size: rest`\) is the last field"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+    broken["commands"]["note"]["response"]["fields"] = {"msg": {"type": "text", "size": 4}}
+    with pytest.raises(SpecErrors, match="a text field's size is `rest`"):
+        resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))

@@ -101,38 +101,28 @@ device:
 def test_ok_answers_a_g_code_line(tmp_path: Path) -> None:
     """GRBL answers every line with `ok` or `error:N`: a request `answered_by` another command's response. The sim
     answers $H with ok, the client returns it; an `error:9` line in its place is a DeviceError naming it."""
-    import os
-    import threading
+    import importlib
 
     from conftest import generate_and_import
+    from pty_pair import answering_line
     from serialspec.runtime.errors import DeviceError
-    from sim_process import serve
 
     path = spec(tmp_path, ANSWERED)
     protocol = load_protocol(str(path), "grbl")
     assert protocol.text is not None and protocol.text.answers() == {"$H": (("ok",), ("error",))}
     grbl = generate_and_import(path, tmp_path / "out", "grbl")
-    with serve(str(path)) as port, grbl.Client(port) as client:
-        assert isinstance(client.home(timeout=5), grbl.OkResponse)
-    controller, device = os.openpty()
-    name = os.ttyname(device)
-
-    def refuse() -> None:
-        line = b""
-        while not line.endswith(b"\r\n"):
-            line += os.read(controller, 64)
-        assert line == b"$H\r\n"
-        os.write(controller, b"error:9\r\n")
-
-    answering = threading.Thread(target=refuse)
-    answering.start()
+    simulator = importlib.import_module("grbl.simulator").SIMULATOR()  # in this process: no `serialspec sim` to start
     try:
-        with grbl.Client(name) as client, pytest.raises(DeviceError, match=r"^home \(\$H\): the device refused it"):
-            client.home(timeout=5)
+        with grbl.Client(simulator.start()) as client:
+            assert isinstance(client.home(timeout=5), grbl.OkResponse)
     finally:
-        answering.join(5)
-        os.close(controller)
-        os.close(device)
+        simulator.close()
+    with (
+        answering_line(b"$H\r\n", b"error:9\r\n") as name,
+        grbl.Client(name) as client,
+        pytest.raises(DeviceError, match=r"^home \(\$H\): the device refused it"),
+    ):
+        client.home(timeout=5)
 
 
 def test_answered_by_mistakes_are_one_line_each(tmp_path: Path) -> None:

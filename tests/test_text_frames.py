@@ -458,7 +458,10 @@ commands:
             "text: `separator`, `named` and",
         ),
         (("    response:\n", "    response:\n      text: {start: <, separator: '|', named: ':'}\n"), "needs a `label`"),
-        (("    response:\n", "    response:\n      text: {start: <, separator: '|'}\n"), "needs `text.list`"),
+        (
+            ("    response:\n", "    response:\n      text: {start: <, separator: '|', named: ':'}\n"),
+            "a labelled repeat needs `text.list`",
+        ),
         (("lat: {type: angle,", "lat: {label: LAT, type: angle,"), "lat.label: a label needs `text: {named: ...}`"),
     ],
 )

@@ -469,10 +469,11 @@ static int nmea0183__hex_value(uint8_t c)
 }
 
 /* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; NMEA0183_E_FRAME,
- * NMEA0183_E_CHECKSUM. */
-static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
+ * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
+static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
+    *unchecked = 0;
     for (i = 0u; i < len; i++) {
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
@@ -509,6 +510,8 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
             }
         } else if (NMEA0183__REQUIRED) {
             return NMEA0183_E_CHECKSUM;
+        } else {
+            *unchecked = 1;
         }
     }
 #endif
@@ -544,13 +547,15 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
     return NMEA0183_OK;
 }
 
-/* The frame around fields already written from buf[1]: the start before them, checksum and end after them. */
-static int nmea0183__frame(nmea0183__out_t *o, size_t *len)
+/* The frame around fields already written from buf[1]: the start before them, checksum (unless `unchecked`: a
+ * frame decoded without its optional one) and end after them. */
+static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked)
 {
     size_t k;
     o->b[0] = NMEA0183__START;
+    (void)unchecked;
 #if NMEA0183__CHECKED
-    {
+    if (!unchecked || NMEA0183__REQUIRED) {
         uint32_t sum = nmea0183__checksum(o->b + 1u, o->n - 1u);
         nmea0183__put(o, NMEA0183__MARKER);
         for (k = NMEA0183__DIGITS; k > 0u; k--) {
@@ -1112,7 +1117,7 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
     nmea0183_kind_t kind;
-    int r;
+    int r, unchecked = 0;
     if (frame == NULL || out == NULL) {
         return NMEA0183_E_ARG;
     }
@@ -1123,7 +1128,7 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
-    r = nmea0183__unframe(frame, len, &body, &n);
+    r = nmea0183__unframe(frame, len, &body, &n, &unchecked);
     if (r != NMEA0183_OK) {
         return r;
     }
@@ -1144,6 +1149,7 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         return NMEA0183_E_UNKNOWN;
     }
     out->sent = (int32_t)seps;
+    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
@@ -2053,7 +2059,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
             return r;
         }
     }
-    return nmea0183__frame(&o, len);
+    return nmea0183__frame(&o, len, msg->unchecked);
 }
 #endif
 

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "0d68d097da764938ad683e8624b5773698de66e03b46bfe9250cc2f562c13ac5"
+#define NMEA0183_SPEC_SHA256 "39bba6cbcf4ee3270bf634d5d7b87059c133cc9764cf4167fac0ffa902595b22"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE
@@ -281,11 +281,13 @@ typedef enum {
 } nmea0183_kind_t;
 
 /* One message: its kind, the frame-level talker, how many fields the frame had after the address (-1: every
- * declared one; encode writes that many, so a decoded sentence encodes to the same text) and its fields. */
+ * declared one; encode writes that many, so a decoded sentence encodes to the same text), whether it came without
+ * its optional checksum (encode then writes none) and its fields. */
 typedef struct {
     nmea0183_kind_t kind;
     char talker[3];
     int32_t sent;
+    bool unchecked; /* sent without its optional checksum: encode leaves it out too */
     union {
         nmea0183_gga_response_t gga_response;
         nmea0183_rmc_response_t rmc_response;

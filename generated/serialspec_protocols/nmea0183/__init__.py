@@ -256,6 +256,8 @@ class GgaResponse(TextRecord):
     dgps_station: int | None = None
     #: How many fields the frame had (a decoded message encodes to the same text); -1: every field.
     sent: int = field(default=-1, compare=False, repr=False)
+    #: Sent without its checksum (which may be left out): encoded again without it.
+    unchecked: bool = field(default=False, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -295,6 +297,8 @@ class RmcResponse(TextRecord):
     mode: Mode | None = None
     #: How many fields the frame had (a decoded message encodes to the same text); -1: every field.
     sent: int = field(default=-1, compare=False, repr=False)
+    #: Sent without its checksum (which may be left out): encoded again without it.
+    unchecked: bool = field(default=False, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -325,6 +329,8 @@ class VtgResponse(TextRecord):
     mode: Mode | None = None
     #: How many fields the frame had (a decoded message encodes to the same text); -1: every field.
     sent: int = field(default=-1, compare=False, repr=False)
+    #: Sent without its checksum (which may be left out): encoded again without it.
+    unchecked: bool = field(default=False, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -361,6 +367,8 @@ class GsaResponse(TextRecord):
     vdop: Decimal | float | None = None
     #: How many fields the frame had (a decoded message encodes to the same text); -1: every field.
     sent: int = field(default=-1, compare=False, repr=False)
+    #: Sent without its checksum (which may be left out): encoded again without it.
+    unchecked: bool = field(default=False, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -400,6 +408,8 @@ class GsvResponse(TextRecord):
     satellites: tuple[GsvResponseSatellites, ...] = ()
     #: How many fields the frame had (a decoded message encodes to the same text); -1: every field.
     sent: int = field(default=-1, compare=False, repr=False)
+    #: Sent without its checksum (which may be left out): encoded again without it.
+    unchecked: bool = field(default=False, compare=False, repr=False)
 
 
 MESSAGE_TYPES: tuple[type[TextRecord], ...] = (GgaResponse, RmcResponse, VtgResponse, GsaResponse, GsvResponse)

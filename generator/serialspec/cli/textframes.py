@@ -19,7 +19,7 @@ def frame_of(framing: TextFraming, given: str) -> bytes:
     """A frame given on the command line: as typed (starting with the start character; the line ending may be
     left out, or written as \\r\\n) or as hex."""
     text = given.strip()
-    if text.startswith(framing.start):
+    if text.startswith((framing.start, framing.response_start or framing.start)):
         text = text.replace("\\r", "\r").replace("\\n", "\n")
         try:
             return text.encode("ascii")
@@ -39,7 +39,7 @@ def describe(
     framing: TextFraming = package.FRAMING
     sentence = framing.decode(frame, direction, reply)
     cls = package.CODEC.classes[sentence.code, sentence.direction]
-    body = frame.decode("ascii")
+    body = frame.decode("latin-1")  # ASCII, its line ending perhaps not
     return {
         "protocol": protocol,
         "direction": cls.DIRECTION.value,
@@ -50,7 +50,9 @@ def describe(
         "sent": sentence.sent,
         # a frame whose checksum fails does not decode; one without a checksum (none in the framing, or left out
         # where `required: false` allows it) was not checked
-        "checksum_ok": True if framing.checksum is not None and framing.marker in body else None,
+        "checksum_ok": True
+        if framing.checksum is not None and framing.marker in body and sentence.direction in framing.checksummed
+        else None,
         "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
     }
 
@@ -98,8 +100,8 @@ def readable(result: dict[str, Any]) -> str:
 
 
 def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_hex: bool) -> int:
-    """The JSON object decode --json prints (fields as their texts; talker and sent may be left out) -> the frame,
-    as text (without its line ending) or as hex."""
+    """The JSON object decode --json prints (fields as their texts; talker, sent and checksum_ok may be left out)
+    -> the frame, as text (without its line ending) or as hex."""
     framing: TextFraming = package.FRAMING
     command = data["command"]
     cls = next(
@@ -120,9 +122,11 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
         values = from_texts(framing.sentence(cls.CODE, cls.DIRECTION.value), fields)
     except DecodeError as exc:
         raise EncodeError(str(exc)) from None
-    frame = framing.encode(cls.CODE, values, talker, sent, cls.DIRECTION.value)
+    # what decode --json says of a frame sent without its optional checksum (`"checksum_ok": null`) leaves it out
+    unchecked = "checksum_ok" in data and data["checksum_ok"] is None and not framing.required
+    frame = framing.encode(cls.CODE, values, talker, sent, cls.DIRECTION.value, unchecked)
     if as_hex:
         print(frame.hex(" "))
     else:
-        print(frame.decode("ascii").removesuffix(framing.end))
+        print(frame.decode("latin-1").removesuffix(framing.end))
     return 0

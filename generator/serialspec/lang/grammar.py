@@ -457,7 +457,9 @@ _FIELD_LONG: dict[str, Shape] = {
         "bytes, string: a number, `rest` (up to the end of the content) or the name of an earlier integer field, "
         "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "
         "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE); array: the earlier "
-        "field holding the array's size in bytes (Modbus byte_count)",
+        "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
+        "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
+        "mismatch, Last Line: 122` as one text); the C target and the Wireshark dissector refuse it, saying so.",
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str(
@@ -513,7 +515,8 @@ _FIELD_LONG: dict[str, Shape] = {
     "inferred": TEXT,
     "precision": Int(
         "text decimal, angle, time: fraction digits written for a value that does not carry its own (a float; a "
-        "decoded value keeps the digits it was sent with).",
+        "decoded value keeps the digits it was sent with); a decimal without one writes a float in its shortest "
+        "form (2.5, never rounded to 2).",
         minimum=0,
         example=4,
     ),
@@ -570,19 +573,41 @@ TEXT_LAYOUT = Obj(
     {
         "start": Str(
             "What the message's text starts with, right after the framing's own start (GRBL's status report: `<`); "
-            "not a letter, digit or character of a text code: frames are told apart by it.",
+            "not a letter, digit or character of a text code: frames are told apart by it. Without one the message "
+            "is found by its code at the start of the frame (after the talker), the longest code that fits: the "
+            "code, then `after_code`, then the fields (Roboteq's `A=12:13` answering `?A`: `text: {separator: "
+            '"=", list: ":"}`).',
             example="<",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
-        "separator": Str("One character between the code and the fields, and between fields (`|`).", example="|"),
+        "separator": Str(
+            "One character between the code and the fields, and between fields (`|`); default the framing's. "
+            'Empty with labels glued to their values (`named: ""`): nothing between them.',
+            example="|",
+        ),
+        "after_code": Str(
+            "What comes between the code and the first field, in place of `separator` (at most one character): "
+            'empty glues the first value to the code (Lynxmotion LSS\'s `D1800`: `text: {after_code: ""}`; '
+            "G-code's line number `N123` before the line). A frame of the code alone carries no fields. A code "
+            "glued to its value may begin another code only where that value is a number and the other code goes "
+            "on with no digit or sign (LSS's `Q` beside `QD`): the longest code that fits is read.",
+            example="",
+        ),
         "named": Str(
             "One character between a field's `label` and its value (`:`): every field has a label and is found "
-            "by it, in any order.",
+            'by it, in any order. Empty (`named: ""`) glues each label to its value, in a message found by its '
+            "code (no `start`): G-code's `G1 X10.5 Y-3` (`code: G1`, `x: {label: X, type: decimal}`); with "
+            '`separator: ""` too, the values are numbers, each ending where a label begins (Lynxmotion LSS\'s '
+            "`D1800T1500`: `position: {label: D}` labelled with the code, right after it, then `time: {label: "
+            "T}`). No label may begin another.",
             example=":",
         ),
-        "list": Str("One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`).", example=","),
+        "list": Str(
+            "One character between a repeat's values (`,`: `MPos:1.000,2.000,3.000`); needed with `named`, else "
+            "a repeat's values are separated as fields are.",
+            example=",",
+        ),
     },
-    required=("start", "separator"),
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
     "checksum and line end stay the framing's.",
@@ -1243,9 +1268,22 @@ FRAMING = Obj(
             default="binary",
             example="text",
         ),
-        "start": Str(
+        "start": OneOf(
+            (
+                Str(),
+                Obj(
+                    {
+                        "request": Str("The requests' start (`#`).", example="#"),
+                        "response": Str("The responses' start (`*`).", example="*"),
+                    },
+                    required=("request", "response"),
+                ),
+            ),
             "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
-            "line ending) and the stream parser resynchronises at the next line ending.",
+            "line ending) and the stream parser resynchronises at the next line ending. A mapping gives each "
+            'direction its own (Lynxmotion LSS: `start: {request: "#", response: "*"}`, `#5QD` asked and '
+            "`*5QD1800` answered): a frame's start then says its direction. The C target and the Wireshark "
+            "dissector refuse starts that differ by direction, saying so.",
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),
@@ -1258,11 +1296,15 @@ FRAMING = Obj(
                     choices=("sum", "xor"),
                 ),
                 "invert": Bool("sum: bitwise NOT of the sum.", default=False, example=True),
-                "marker": Str("The character before the checksum's hex digits.", default="*"),
+                "marker": Str("The character before the checksum's digits.", default="*"),
                 "format": Str(
-                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum).",
-                    choices=("hex2",),
+                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum, NMEA 0183); "
+                    "decimal, its value in decimal digits without leading zeros, 0 to 255 (G-code's line checksum, "
+                    "Marlin and RepRap firmware: `N1 G28*18`; ODrive's ASCII protocol). The C target and the "
+                    "Wireshark dissector refuse a decimal one, saying so.",
+                    choices=("hex2", "decimal"),
                     default="hex2",
+                    example="decimal",
                 ),
                 "required": Bool(
                     "Frames without a checksum are refused (false: accepted unchecked, as NMEA 0183 allows for "
@@ -1270,11 +1312,27 @@ FRAMING = Obj(
                     default=True,
                     example=False,
                 ),
+                "separated": ListOf(
+                    Str(choices=("request", "response")),
+                    "The directions whose frames write the separator between the last field and the marker, "
+                    "covered by the checksum (ODrive's documented request `r vbus_voltage *93`; its replies, "
+                    "`12.5*48`, do not: `separated: [request]`); decode also takes such a frame without it. The C "
+                    "target and the Wireshark dissector refuse it, saying so.",
+                    example=["request"],
+                ),
+                "directions": ListOf(
+                    Str(choices=("request", "response")),
+                    "The directions whose frames carry it (default both): G-code's numbered lines carry one, the "
+                    "firmware's `ok` and `Resend: 124` none (`directions: [request]`); a frame of the other "
+                    "direction is text to its end, the marker too. The C target and the Wireshark dissector refuse "
+                    "a checksum in one direction only, saying so.",
+                    example=["request"],
+                ),
             },
             required=("algorithm",),
             description=(
                 "text: the checksum over the characters between `start` and `marker`, written after `marker` as "
-                "hex digits, before the line ending."
+                "hex digits (or decimal ones: `format`), before the line ending."
             ),
         ),
         "talker": Obj(
@@ -1288,6 +1346,14 @@ FRAMING = Obj(
                 "text: a frame-level value at the start of the first field, before the text code (NMEA's talker "
                 "id: GP in $GPGGA); every message carries it as `talker`."
             ),
+        ),
+        "address": Str(
+            "text: a shared integer field (its name in `fields:`) that every message carries first, its digits "
+            "written right after the start and before the talker and code, with nothing between (Lynxmotion LSS's "
+            "servo id: `address: id` reads `#5D1800` as id 5, code D, 1800). Messages, JSON and client methods have "
+            "it as a field; the simulator answers with the request's. The C target and the Wireshark dissector "
+            "refuse it, saying so.",
+            example="id",
         ),
         "max_length": Int(
             "text: the longest frame in characters, start to checksum (NMEA 0183: 82 with the line ending): the "

@@ -21,7 +21,7 @@ from enum import Enum
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, RangeError, shown
 from serialspec.runtime.message import Direction
-from serialspec.runtime.values import asdict, dataclass, field, fields
+from serialspec.runtime.values import asdict, dataclass, field, fields, replace
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
 if TYPE_CHECKING:
@@ -111,6 +111,8 @@ class TextField:
     maximum: float | None = None
     letters: type[Enum] | None = None
     label: str = ""  # in a message with its own layout (TextLayout.named): the label its value follows
+    address: bool = False  # every message's first field, its digits right after the start, before the code (LSS's id)
+    rest: bool = False  # text: the rest of the line, separators included (`size: rest`: Marlin's `Error:...`)
 
 
 @dataclass(frozen=True)
@@ -132,11 +134,18 @@ class TextLayout:
     value, found by the label in any order (an absent label: None), the field labelled with the code right after
     the code (`Hold:0`); a repeat's values are joined by `list`."""
 
-    start: str
+    start: str = ""
     end: str = ""
     separator: str = ","
     named: str = ""
     list: str = ""
+    after_code: str | None = None  # between the code and the first field (None: the separator; "": glued: `D1800`)
+    glued: bool = False  # labels glued to their values (`named: ""`): G-code's `X10.5`, LSS's `D1800T1500`
+
+    @property
+    def labelled(self) -> bool:
+        """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
+        return bool(self.named) or self.glued
 
 
 @dataclass(frozen=True)
@@ -174,14 +183,16 @@ class Sentence:
     values: dict[str, Any]
     sent: int = -1  # fields after the address (-1: every declared field)
     direction: str = "response"
+    unchecked: bool = False  # sent without its (optional) checksum: encoding it again leaves the checksum out
 
 
 @dataclass(frozen=True)
 class TextFraming:
     """The frame: `start` + address (talker + code) + separator-joined fields + [marker + checksum as hex] + `end`.
 
-    checksum: the function over the characters between start and marker (from the checksum registry); `required`
-    says whether a frame without one is refused. talker: how many leading characters of the address are the
+    checksum: the function over the characters between start and marker (from the checksum registry), written as
+    `digits` upper-case hex digits or, with `decimal`, in decimal digits without leading zeros (G-code's `*71`);
+    `required` says whether a frame without one is refused. talker: how many leading characters of the address are the
     frame-level value (0: none). max_length: longest frame the stream parser waits for, in characters.
     """
 
@@ -196,18 +207,30 @@ class TextFraming:
     talker: int = 0
     talkers: tuple[str, ...] = ()  # the talker values encode accepts (empty: any)
     max_length: int = 82
+    decimal: bool = False  # the checksum written in decimal (G-code: `N1 G28*18`), not as `digits` hex digits
+    checksummed: tuple[str, ...] = ("request", "response")  # the directions whose frames carry the checksum
+    separated: tuple[str, ...] = ()  # the directions whose frames write the separator before the checksum's marker
+    response_start: str = ""  # the responses' own start, where it differs from the requests' (`start`): LSS's `*`
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
     layouts: tuple[TextLayout, ...] = field(init=False, repr=False, compare=False)  # the messages' own, each once
+    # the messages found by their code alone (their own text without a start), the longest code first
+    alone: tuple[TextSentence, ...] = field(init=False, repr=False, compare=False)
+    # every message's first field where it is an address written before the code (LSS's servo id), else None
+    address: TextField | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         by_code: dict[str, dict[str, TextSentence]] = {}
         for sentence in self.sentences:
             by_code.setdefault(sentence.code, {})[sentence.direction] = sentence
         object.__setattr__(self, "by_code", by_code)
-        layouts = {s.layout: None for s in self.sentences if s.layout is not None}
+        layouts = {s.layout: None for s in self.sentences if s.layout is not None and s.layout.start}
         object.__setattr__(self, "layouts", tuple(layouts))
+        alone = [s for s in self.sentences if s.layout is not None and not s.layout.start]
+        object.__setattr__(self, "alone", tuple(sorted(alone, key=lambda s: -len(s.code))))
+        firsts = [s.fields[0] for s in self.sentences if s.fields]
+        object.__setattr__(self, "address", next((f for f in firsts if isinstance(f, TextField) and f.address), None))
 
     def sentence(self, code: str, direction: str | None = None, asked: bool = False) -> TextSentence:
         """The message a code names, in `direction` where the code names one each way; DecodeError where there is
@@ -222,6 +245,9 @@ class TextFraming:
         if len(found) == 1:  # the code says the direction (an answer-only code read by a request parser too)
             return next(iter(found.values()))
         if direction is None:
+            coded = [s for s in found.values() if not s.bare]
+            if len(coded) == 1:  # beside a reply of values alone, which never starts with its code
+                return coded[0]
             raise DirectionNeeded(code)
         return found[direction]
 
@@ -232,26 +258,119 @@ class TextFraming:
         `direction` is needed only for a code that names a request and a response. `reply`: the code of the reply
         awaited (the answer to the request before this frame; given, the request is known): where that reply is its
         values alone (`bare`), a frame that does not start with another message's code is read as it."""
-        text = _ascii(frame)
+        text = _ascii(frame, self.end)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
-        if not text.startswith(self.start):
+        if self.response_start:  # each direction its own start: the start says the direction
+            said = "response" if text.startswith(self.response_start) else "request"
+            start = self.start_of(said)
+            if not text.startswith(start) or direction not in (None, said):
+                wanted = f"{self.start!r} (a request) or {self.response_start!r} (a response)"
+                if direction is not None:
+                    wanted = repr(self.start_of(direction))
+                raise DecodeError(f"text frame does not start with {wanted}: {shown(text[:20])}")
+            direction = said
+        elif not text.startswith(self.start):
             raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
         body = text[len(self.start) :]
-        body = self._checked(body)
+        if self.checksum is None or len(self.checksummed) == 2:
+            return self._decode_checked(body, direction, reply)
+        # a checksum in one direction only: a frame of the other is all text (its fields may hold the marker)
+        if direction is not None and direction not in self.checksummed:
+            return self._decode_body(body, direction, reply)
+        if direction is None:  # a frame that reads as the other direction's whole is one
+            try:
+                whole = self._decode_body(body, None, reply)
+            except DecodeError:
+                whole = None
+            if whole is not None and whole.direction not in self.checksummed:
+                return whole
+        return self._decode_checked(body, direction, reply)
+
+    def _decode_checked(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """A frame of a direction that carries the checksum; one sent without it (where it may be left out) says so,
+        so that it encodes again without it."""
+        covered = self._checked(body, direction)
+        sentence = self._decode_body(covered, direction, reply)
+        if self.checksum is not None and covered == body:
+            return replace(sentence, unchecked=True)
+        return sentence
+
+    def _decode_body(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """The text between start and checksum (the checksum checked) -> its sentence; the address first, where
+        every message has one (its digits, right after the start)."""
+        if self.address is None:
+            return self._decode_rest(body, direction, reply)
+        digits = 0
+        while digits < len(body) and body[digits] in _DIGITS:
+            digits += 1
+        value = decode_field("address", self.address, body[:digits])
+        sentence = self._decode_rest(body[digits:], direction, reply)
+        return replace(sentence, values={self.address.name: value, **sentence.values})
+
+    def _decode_rest(self, body: str, direction: str | None, reply: str | None) -> Sentence:
+        """The text after the address (all of it where the messages have none) -> its sentence."""
         for layout in self.layouts:
             if body.startswith(layout.start) and body[len(layout.start) :].endswith(layout.end):
                 return self._decode_in(layout, body[len(layout.start) : len(body) - len(layout.end)], direction)
         parts = body.split(self.separator)
         address = parts[0]
         talker, code = address[: self.talker], address[self.talker :]
+        if self.alone and not self._plain(code, direction):
+            found = self._decode_alone(talker, body[self.talker :], direction)
+            if found is not None:
+                return found
         if reply is not None and direction != "request":
             bare = self.by_code.get(reply, {}).get("response")
             if bare is not None and bare.bare and not self._coded(code, direction):
-                return Sentence("", reply, _decode_fields(bare, parts), len(parts), "response")
+                return Sentence("", reply, _decode_fields(bare, parts, self.separator), _count(bare, parts), "response")
         sentence = self.sentence(code, direction, reply is not None)
-        values = _decode_fields(sentence, parts[1:])
-        return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
+        values = _decode_fields(sentence, parts[1:], self.separator)
+        return Sentence(talker, code, values, _count(sentence, parts[1:]), sentence.direction)
+
+    def _plain(self, code: str, direction: str | None) -> bool:
+        """Whether `code` is that of a message sent in the framing's own text (no layout of its own), in
+        `direction` (None: either)."""
+        found = self.by_code.get(code, {}).values()
+        return any(s.layout is None and not s.bare and direction in (None, s.direction) for s in found)
+
+    def _decode_alone(self, talker: str, text: str, direction: str | None) -> Sentence | None:
+        """A frame of a message found by its code alone (its own text without a start): the longest such code the
+        text starts with, then the layout's `after_code` and fields; None when no such code fits."""
+        matched: list[tuple[TextSentence, str | None]] = []
+        for sentence in self.alone:
+            layout = sentence.layout
+            if layout is None or direction not in (None, sentence.direction) or not text.startswith(sentence.code):
+                continue
+            if matched and len(sentence.code) < len(matched[0][0].code):
+                break
+            rest = text[len(sentence.code) :]
+            after = layout.separator if layout.after_code is None else layout.after_code
+            if layout.glued and any(item.label == sentence.code for item in _sent(sentence)):
+                after = ""  # the value labelled with the code follows it (LSS's `D1800`)
+            if not rest:
+                matched.append((sentence, None))
+            elif rest.startswith(after) and rest.endswith(layout.end):
+                matched.append((sentence, rest[len(after) : len(rest) - len(layout.end)]))
+        if not matched:
+            return None
+        if len(matched) > 1:
+            raise DirectionNeeded(matched[0][0].code)
+        sentence, inner = matched[0]
+        layout = sentence.layout
+        assert layout is not None  # every message in `alone` has its own text
+        if layout.glued:  # the code is the label of the value right after it, where a field has it as its label
+            own = any(item.label == sentence.code for item in _sent(sentence))
+            values = _labelled_values(
+                sentence, layout, _glued(sentence, layout, (sentence.code if own else "") + (inner or ""))
+            )
+            return Sentence(talker, sentence.code, values, -1, sentence.direction)
+        texts = inner.split(layout.separator) if inner else []  # the code alone: no fields
+        if layout.named:
+            values = _decode_labelled(sentence, layout, texts)
+        else:
+            values = _decode_fields(sentence, [t for p in texts for t in _split(p, layout.list)], layout.separator)
+        return Sentence(talker, sentence.code, values, -1, sentence.direction)
 
     def _coded(self, code: str, direction: str | None) -> bool:
         """Whether a frame's first field is the code of a message sent with its code, in `direction` (None: either;
@@ -271,10 +390,18 @@ class TextFraming:
         if layout.named:
             values = _decode_labelled(sentence, layout, [after, *parts[1:]] if after != code else parts[1:])
         else:
-            values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)])
+            values = _decode_fields(sentence, [t for p in parts[1:] for t in _split(p, layout.list)], layout.separator)
         return Sentence(talker, code, values, -1, sentence.direction)
 
-    def _checked(self, body: str) -> str:
+    def _checked(self, body: str, direction: str | None) -> str:
+        """The text before the checksum, the checksum checked (and the separator before its marker taken off, in a
+        direction that writes one there)."""
+        covered = self._covered(body)
+        if covered != body and self.separated and direction in (None, *self.separated):
+            return covered.removesuffix(self.separator)
+        return covered
+
+    def _covered(self, body: str) -> str:
         if self.checksum is None:
             return body
         at = body.rfind(self.marker)
@@ -283,9 +410,15 @@ class TextFraming:
                 raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
             return body
         written, covered = body[at + len(self.marker) :], body[:at]
+        computed = self.checksum(covered.encode("ascii"))
+        if self.decimal:
+            if not 1 <= len(written) <= 3 or any(c not in _DIGITS for c in written):
+                raise ChecksumError(f"checksum {shown(written)} is not a decimal number of 1 to 3 digits")
+            if int(written) != computed:
+                raise ChecksumError(f"checksum {written} does not match the frame's {computed}")
+            return covered
         if len(written) != self.digits or not written or any(c not in _HEX_DIGITS for c in written):
             raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
-        computed = self.checksum(covered.encode("ascii"))
         if int(written, 16) != computed:
             raise ChecksumError(f"checksum {written} does not match the frame's {computed:0{self.digits}X}")
         return covered
@@ -293,7 +426,13 @@ class TextFraming:
     # --- encoding --------------------------------------------------------------------------------------------------
 
     def encode(
-        self, code: str, values: Mapping[str, Any], talker: str = "", sent: int = -1, direction: str | None = None
+        self,
+        code: str,
+        values: Mapping[str, Any],
+        talker: str = "",
+        sent: int = -1,
+        direction: str | None = None,
+        unchecked: bool = False,
     ) -> bytes:
         """A sentence's values -> the frame; EncodeError (RangeError) names the field at fault before any text is
         written. `sent` is the number of fields to write (a decoded Sentence's); -1 writes every declared one."""
@@ -307,28 +446,47 @@ class TextFraming:
         unknown = set(values) - {f.name for f in sentence.fields}
         if unknown:
             raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+        address = ""
+        if self.address is not None:  # its digits before everything else
+            address = encode_field(sentence.where, self.address, values.get(self.address.name))
         if sentence.layout is not None:
-            return self.frame(_encode_in(sentence, sentence.layout, values, talker + code, self._forbidden()))
-        parts = _encode_fields(sentence, values, self._forbidden())
+            forbidden = self._forbidden(sentence.direction)
+            inner = _encode_in(sentence, sentence.layout, values, talker + code, forbidden, self.separator)
+            return self.frame(address + inner, sentence.direction, unchecked)
+        parts = _encode_fields(sentence, values, self._forbidden(sentence.direction), self.separator)
         if sent >= 0:
             if any(parts[sent:]):
                 raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
             parts = (parts + [""] * sent)[:sent]
         body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
-        return self.frame(body)
+        return self.frame(address + body, sentence.direction, unchecked)
 
-    def frame(self, body: str) -> bytes:
-        """The text between start and checksum marker, framed."""
-        text = self.start + body
-        if self.checksum is not None:
-            text += f"{self.marker}{self.checksum(body.encode('ascii')):0{self.digits}X}"
-        return (text + self.end).encode("ascii")
+    def start_of(self, direction: str | None) -> str:
+        """The start of a frame in `direction` (the requests' where the responses have none of their own)."""
+        return self.response_start if direction == "response" and self.response_start else self.start
+
+    def frame(self, body: str, direction: str | None = None, unchecked: bool = False) -> bytes:
+        """The text between start and checksum marker, framed (with its checksum where `direction` has one, unless
+        `unchecked`: left out, where the framing lets it be)."""
+        text = self.start_of(direction) + body
+        written = not (unchecked and not self.required)
+        if self.checksum is not None and written and (direction is None or direction in self.checksummed):
+            if direction in self.separated:  # ODrive's `r vbus_voltage *93`: covered with the rest
+                text, body = text + self.separator, body + self.separator
+            value = self.checksum(body.encode("ascii"))
+            text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
+        return (text + self.end).encode("latin-1")  # the line ending may hold bytes above 0x7F (Nextion's FF FF FF)
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
-        return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction)
+        return self.encode(
+            sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction, sentence.unchecked
+        )
 
-    def _forbidden(self) -> str:
-        return "".join({self.start, self.separator, self.marker, *self.end})
+    def _forbidden(self, direction: str) -> str:
+        """The framing's own characters, which no field of a frame in `direction` may hold (the checksum's marker
+        only where that direction carries a checksum)."""
+        marker = self.marker if self.checksum is not None and direction in self.checksummed else ""
+        return "".join({self.start, self.response_start, self.separator, marker, *self.end} - {""})
 
 
 # --- fields -------------------------------------------------------------------------------------------------------
@@ -337,6 +495,8 @@ class TextFraming:
 # a sentence, and `serialspec decode PACKAGE SENTENCE` would compile each on every start. A digit is what \d matches
 # (str.isdecimal: any Unicode decimal digit, as int() and Decimal() read them).
 _HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
+_DIGITS = frozenset("0123456789")
+_NUMBER = frozenset("0123456789+-.")  # what a number glued between labels may hold
 
 
 def _unsigned(text: str) -> str:
@@ -348,13 +508,44 @@ def _split(text: str, by: str) -> list[str]:
     return text.split(by) if by else [text]
 
 
+def _glued(sentence: TextSentence, layout: TextLayout, text: str) -> list[tuple[str, str, bool]]:
+    """(label, value, found) of each labelled value glued to its label (`named: ""`): the longest label a piece
+    starts with; without a separator, a value is the run of number characters after its label (`D1800T1500`)."""
+    labels = sorted((item.label for item in _sent(sentence)), key=len, reverse=True)
+    found: list[tuple[str, str, bool]] = []
+    if layout.separator:
+        for piece in text.split(layout.separator) if text else ():
+            label = next((lb for lb in labels if piece.startswith(lb)), None)
+            found.append((label, piece[len(label) :], True) if label is not None else (piece, "", False))
+        return found
+    at = 0
+    while at < len(text):
+        label = next((lb for lb in labels if text.startswith(lb, at)), None)
+        if label is None:
+            return [*found, (text[at:], "", False)]
+        end = at + len(label)
+        while end < len(text) and text[end] in _NUMBER:
+            end += 1
+        found.append((label, text[at + len(label) : end], True))
+        at = end
+    return found
+
+
 def _decode_labelled(sentence: TextSentence, layout: TextLayout, parts: list[str]) -> dict[str, Any]:
     """Fields found by their labels (`label` + `named` + value), in any order; an absent one is None (a repeat: [])."""
-    items = {item.label: item for item in sentence.fields}
-    values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in sentence.fields}
+    pairs = (
+        _glued(sentence, layout, layout.separator.join(parts))
+        if layout.glued
+        else [(lb, text, bool(found)) for lb, found, text in (p.partition(layout.named) for p in parts)]
+    )
+    return _labelled_values(sentence, layout, pairs)
+
+
+def _labelled_values(sentence: TextSentence, layout: TextLayout, pairs: list[tuple[str, str, bool]]) -> dict[str, Any]:
+    items = {item.label: item for item in _sent(sentence)}
+    values: dict[str, Any] = {item.name: [] if isinstance(item, TextRepeat) else None for item in _sent(sentence)}
     seen: set[str] = set()
-    for part in parts:
-        label, found, text = part.partition(layout.named)
+    for label, text, found in pairs:
         item = items.get(label)
         if not found or item is None:
             expected = ", ".join(items) or "none"
@@ -380,37 +571,64 @@ def _decode_labelled(sentence: TextSentence, layout: TextLayout, parts: list[str
 
 
 def _encode_in(
-    sentence: TextSentence, layout: TextLayout, values: Mapping[str, Any], address: str, forbidden: str
+    sentence: TextSentence, layout: TextLayout, values: Mapping[str, Any], address: str, forbidden: str, outer: str = ""
 ) -> str:
     """The text of a message in its own layout: start, address, fields (labelled ones only where they have a value),
     end."""
-    forbidden += "".join({layout.start, layout.end, layout.separator, layout.named, layout.list} - {""})
+    forbidden += "".join(
+        {layout.start, layout.end, layout.separator, layout.named, layout.list, layout.after_code or ""} - {""}
+    )
     parts = [address]
-    for item in sentence.fields:
+    for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
-            text = encode_field(sentence.where, item, value, forbidden)
-            if layout.named and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
+            allowed = forbidden
+            if item.rest:  # the rest of the line: the message's own characters too (not the framing's)
+                for own in (layout.separator, layout.after_code or "", outer):
+                    allowed = allowed.replace(own, "") if own else allowed
+            text = encode_field(sentence.where, item, value, allowed)
+            if layout.labelled and item.label == sentence.code:  # the code's own value, right after it (`Hold:0`)
                 parts[0] += f"{layout.named}{text}" if value is not None else ""
-            elif value is not None or not layout.named:
-                parts.append(f"{item.label}{layout.named}{text}" if layout.named else text)
+            elif value is not None or not layout.labelled:
+                parts.append(f"{item.label}{layout.named}{text}" if layout.labelled else text)
             continue
-        if not value and layout.named:
+        if not value and layout.labelled:
             continue  # an absent label
         single = TextSentence(sentence.code, (item,), sentence.where)
         texts = _encode_fields(single, {item.name: value}, forbidden)
+        if not texts:
+            continue  # a repeat of no groups (at the end, `max_count`): nothing, not an empty field
         joined = (layout.list or layout.separator).join(texts)
-        parts.append(f"{item.label}{layout.named}{joined}" if layout.named else joined)
-    return layout.start + layout.separator.join(parts) + layout.end
+        parts.append(f"{item.label}{layout.named}{joined}" if layout.labelled else joined)
+    after = layout.separator if layout.after_code is None else layout.after_code
+    joined = layout.separator.join(parts[1:])
+    # found by its code alone: a frame whose fields have no text is the code alone
+    fields = after + joined if len(parts) > 1 and (joined or layout.start) else ""
+    return layout.start + parts[0] + fields + layout.end
 
 
-def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:
+def _sent(sentence: TextSentence) -> tuple[TextField | TextRepeat, ...]:
+    """The fields written after the code: all but an address (written before it)."""
+    first = sentence.fields[0] if sentence.fields else None
+    return sentence.fields[1:] if isinstance(first, TextField) and first.address else sentence.fields
+
+
+def _count(sentence: TextSentence, parts: list[str]) -> int:
+    """How many fields a frame of these parts had (a text to the end of the line, separators and all, is one)."""
+    fields = _sent(sentence)
+    if fields and isinstance(fields[-1], TextField) and fields[-1].rest:
+        return min(len(parts), len(fields))
+    return len(parts)
+
+
+def _decode_fields(sentence: TextSentence, parts: list[str], separator: str = "") -> dict[str, Any]:
     values: dict[str, Any] = {}
     at = 0
-    for item in sentence.fields:
+    for item in _sent(sentence):
         if isinstance(item, TextField):
-            values[item.name] = decode_field(sentence.where, item, parts[at] if at < len(parts) else "")
-            at += 1
+            text = separator.join(parts[at:]) if item.rest else parts[at] if at < len(parts) else ""
+            values[item.name] = decode_field(sentence.where, item, text)
+            at = max(at + 1, len(parts)) if item.rest else at + 1
             continue
         size = len(item.fields)
         groups = item.count or min(item.maximum, -(-(len(parts) - at) // size))
@@ -513,12 +731,15 @@ def _looks(spec: TextField) -> str:
             return f"a{'n' if spec.kind[0] in 'aeiou' else ''} {spec.kind}"
 
 
-def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str) -> list[str]:
+def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str, separator: str = "") -> list[str]:
     parts: list[str] = []
-    for item in sentence.fields:
+    for item in _sent(sentence):
         value = values.get(item.name)
         if isinstance(item, TextField):
-            parts.append(encode_field(sentence.where, item, value, forbidden))
+            # a text to the end of the line may hold the separator (and nothing else of the framing's)
+            parts.append(
+                encode_field(sentence.where, item, value, forbidden.replace(separator, "") if item.rest else forbidden)
+            )
             continue
         rows = list(value or ())
         limit = item.count or item.maximum
@@ -566,7 +787,7 @@ def _put_decimal(spec: TextField, value: Any, where: str) -> str:
     number = _number(spec, value, where)
     if isinstance(value, Fixed):
         return _padded(format(number, "f"), value.width)
-    if isinstance(value, Decimal):
+    if isinstance(value, Decimal) or not spec.precision:  # a float with no precision: its shortest form, unrounded
         return _padded(format(number, "f"), spec.width)
     return _padded(f"{number:.{spec.precision}f}", spec.width)
 
@@ -690,13 +911,16 @@ def _field_text(sentence: TextSentence, name: str, given: Any) -> str:
     return given if isinstance(given, str) else str(given)
 
 
-def _ascii(frame: bytes | str) -> str:
+def _ascii(frame: bytes | str, end: str = "") -> str:
+    """A frame's characters: ASCII, but for a line ending `end` that may hold bytes above 0x7F (Nextion's FF FF FF),
+    each such byte a character of the same number."""
     if isinstance(frame, str):
         return frame
-    try:
-        return bytes(frame).decode("ascii")
-    except UnicodeDecodeError as error:
-        raise DecodeError(f"text frame holds a non-ASCII byte {frame[error.start]:02X}") from None
+    text = bytes(frame).decode("latin-1")
+    body = text[: -len(end)] if end and text.endswith(end) else text
+    if bad := next((c for c in body if c > "\x7f"), None):
+        raise DecodeError(f"text frame holds a non-ASCII byte {ord(bad):02X}")
+    return text
 
 
 # --- the stream parser --------------------------------------------------------------------------------------------
@@ -714,7 +938,9 @@ class TextStreamParser:
         self._awaited: str | None = None  # the code of the reply awaited (expect), where it is values alone
         self._overlong = False  # frames without a start character: the line being read was dropped as too long
         self._start = framing.start.encode("ascii")
-        self._end = framing.end.encode("ascii")
+        # every start a frame may have (one character each where the directions have their own)
+        self._starts = tuple(s.encode("ascii") for s in dict.fromkeys((framing.start, framing.response_start)) if s)
+        self._end = framing.end.encode("latin-1")
         self._buffer = b""
         self.corrupt = 0
         self.last_error = ""
@@ -726,13 +952,13 @@ class TextStreamParser:
         if not self._start:
             return self._lines(found, limit)
         while True:
-            start = self._buffer.find(self._start)
+            start = self._find_start(0)
             if start < 0:
                 self._buffer = self._buffer[-(len(self._start) - 1) :] if len(self._start) > 1 else b""
                 return found
             self._buffer = self._buffer[start:]
             end = self._buffer.find(self._end, len(self._start))
-            restart = self._buffer.find(self._start, len(self._start))
+            restart = self._find_start(len(self._start))
             if end < 0 or (0 <= restart < end):
                 if restart >= 0 and (end < 0 or restart < end):
                     self._dropped("text frame cut short by a new start")
@@ -748,6 +974,13 @@ class TextStreamParser:
                 found.append(self._decoded(frame))
             except DecodeError as error:
                 self._dropped(str(error))
+
+    def _find_start(self, at: int) -> int:
+        """Where the first start at or after `at` is in the buffer, or -1."""
+        if len(self._starts) == 1:
+            return self._buffer.find(self._start, at)
+        found = [i for i in (self._buffer.find(s, at) for s in self._starts) if i >= 0]
+        return min(found, default=-1)
 
     def _lines(self, found: list[Sentence], limit: int) -> list[Sentence]:
         """Frames without a start character: each line is a frame. A line that grows past `max_length` is dropped
@@ -805,7 +1038,7 @@ class TextStreamParser:
     def gap(self) -> None:
         """The line went idle: no frame spans it. A frame begun (its start character read; frames without one: a line
         with more than blanks) is dropped as cut short, counted in `corrupt`; the line ending that follows is noise."""
-        begun = self._buffer.startswith(self._start) if self._start else bool(self._buffer.strip(b"\r\n"))
+        begun = self._buffer.startswith(self._starts) if self._start else bool(self._buffer.strip(b"\r\n"))
         if begun and not self._overlong:
             self._dropped("text frame cut short by a gap in the line")
         self._buffer, self._overlong = b"", False
@@ -834,12 +1067,13 @@ class TextRecord:
     FRAMING: ClassVar[TextFraming]
     talker: str
     sent: int
+    # `unchecked` (a class of a framing whose checksum may be left out): sent without it, encoded again without it
 
     def to_fields(self) -> dict[str, Any]:
-        """The field values by name (groups as dicts), without talker and sent."""
+        """The field values by name (groups as dicts), without talker, sent and unchecked."""
         values = {}
         for f in fields(self):  # type: ignore[arg-type]
-            if f.name in ("talker", "sent"):
+            if f.name in ("talker", "sent", "unchecked"):
                 continue
             value = getattr(self, f.name)
             if f.name in self.GROUPS:
@@ -848,7 +1082,7 @@ class TextRecord:
         return values
 
     @classmethod
-    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> Any:
+    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1, unchecked: bool = False) -> Any:
         known = {f.name for f in fields(cls)}  # type: ignore[arg-type]
         unknown = set(values) - known
         if unknown:
@@ -857,16 +1091,22 @@ class TextRecord:
         # talker and sent may come with the values (a simulator builds a message from all its attributes)
         talker = str(given.pop("talker", None) or talker)
         sent = int(given.pop("sent", sent))
+        unchecked = bool(given.pop("unchecked", unchecked))
         for name, group in cls.GROUPS.items():
             if name in given:
                 given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
         if talker:
             given["talker"] = talker
+        if unchecked:
+            if "unchecked" not in known:
+                raise EncodeError(f"{cls.CODE}: its checksum cannot be left out")
+            given["unchecked"] = True
         factory: Any = cls  # a generated value class: its fields are keyword arguments
         return factory(**given, sent=sent)
 
     def encode(self) -> bytes:
-        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent, self.DIRECTION.value)
+        unchecked = bool(getattr(self, "unchecked", False))
+        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent, self.DIRECTION.value, unchecked)
 
 
 class TextCodec:
@@ -893,7 +1133,7 @@ class TextCodec:
 
     def message(self, sentence: Sentence) -> Any:
         cls = self.classes[sentence.code, sentence.direction]
-        return cls.from_fields(sentence.values, sentence.talker, sentence.sent)
+        return cls.from_fields(sentence.values, sentence.talker, sentence.sent, sentence.unchecked)
 
     def decode(self, frame: bytes | str, direction: str | None = None, expect: Any = None, request: Any = None) -> Any:
         """One frame -> its message; DecodeError (ChecksumError) says in one line why not. `direction` ("request"

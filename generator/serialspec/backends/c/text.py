@@ -34,10 +34,24 @@ def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
     if not text.start:
         raise Unsupported("text frames without a start character (every line a frame)")
+    if any(c > "\x7f" for c in text.end):
+        raise Unsupported("a line ending with bytes above 0x7F (`end`)")
+    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
+        raise Unsupported("a text field to the end of the line (`size: rest`)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
     if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
+    if text.checksum is not None and text.checksum_format == "decimal":
+        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
+    if text.checksum is not None and text.checksum_separated:
+        raise Unsupported("a separator before the text checksum (`checksum.separated`)")
+    if text.response_start:
+        raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
+    if text.address is not None:
+        raise Unsupported("an address before the text code (`framing.address`)")
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")
@@ -226,11 +240,13 @@ typedef enum {{
 }} {p}_kind_t;
 
 /* One message: its kind, the frame-level talker, how many fields the frame had after the address (-1: every
- * declared one; encode writes that many, so a decoded sentence encodes to the same text) and its fields. */
+ * declared one; encode writes that many, so a decoded sentence encodes to the same text), whether it came without
+ * its optional checksum (encode then writes none) and its fields. */
 typedef struct {{
     {p}_kind_t kind;
     char talker[{t.talker + 1}];
     int32_t sent;
+    bool unchecked; /* sent without its optional checksum: encode leaves it out too */
     union {{
 {union}
     }} u;
@@ -634,7 +650,7 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
     {p}_kind_t kind;
-    int r;
+    int r, unchecked = 0;
     if (frame == NULL || out == NULL) {{
         return {P}_E_ARG;
     }}
@@ -645,7 +661,7 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}
-    r = {p}__unframe(frame, len, &body, &n);
+    r = {p}__unframe(frame, len, &body, &n, &unchecked);
     if (r != {P}_OK) {{
         return r;
     }}
@@ -662,6 +678,7 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
         return {P}_E_UNKNOWN;
     }}
     out->sent = (int32_t)seps;
+    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
@@ -752,7 +769,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
             return r;
         }}
     }}
-    return {p}__frame(&o, len);
+    return {p}__frame(&o, len, msg->unchecked);
 }}
 #endif
 

@@ -641,10 +641,11 @@ static double pfx__angle_value(const pfx_angle_t *a)
     ),
     Piece(
         r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
- * PFX_E_CHECKSUM. */
-static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
+ * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
+static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
+    *unchecked = 0;
     for (i = 0u; i < len; i++) {
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
@@ -689,6 +690,8 @@ CHECKED_READ = Piece(
             }
         } else if (PFX__REQUIRED) {
             return PFX_E_CHECKSUM;
+        } else {
+            *unchecked = 1;
         }
     }
 #endif
@@ -729,18 +732,20 @@ static int pfx__trim(pfx__out_t *o, size_t sent)
     return PFX_OK;
 }
 
-/* The frame around fields already written from buf[1]: the start before them, checksum and end after them. */
-static int pfx__frame(pfx__out_t *o, size_t *len)
+/* The frame around fields already written from buf[1]: the start before them, checksum (unless `unchecked`: a
+ * frame decoded without its optional one) and end after them. */
+static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked)
 {
     size_t k;
     o->b[0] = PFX__START;
+    (void)unchecked;
 """,
     needs=("trim", "put", "frame"),
 )
 
 CHECKED_WRITE = Piece(
     r"""#if PFX__CHECKED
-    {
+    if (!unchecked || PFX__REQUIRED) {
         uint32_t sum = pfx__checksum(o->b + 1u, o->n - 1u);
         pfx__put(o, PFX__MARKER);
         for (k = PFX__DIGITS; k > 0u; k--) {

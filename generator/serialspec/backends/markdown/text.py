@@ -4,6 +4,7 @@ each example shown character by character."""
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import assert_never
 
 from serialspec.backends.markdown.docs import cell, code_span, period_text, text
 from serialspec.backends.markdown.kinds import anchor
@@ -26,7 +27,7 @@ def _shown(characters: str) -> str:
 def _kind(f: TextField) -> str:
     match f.kind:
         case "decimal":
-            written = f"{f.precision} decimal{'s' if f.precision != 1 else ''}" + (
+            written = (f"{f.precision} decimal{'s' if f.precision != 1 else ''}" if f.precision else "as given") + (
                 f", {f.width} integer digits" if f.width else ""
             )
             return f"decimal ({written})"
@@ -40,6 +41,8 @@ def _kind(f: TextField) -> str:
             return "time (hhmmss" + ("." + "s" * f.precision if f.precision else "") + ")"
         case "date":
             return "date (ddmmyy)"
+        case "text" if f.rest:
+            return "text (the rest of the line, separators included)"
         case _:
             return f.kind
 
@@ -52,14 +55,26 @@ def _range(f: TextField) -> str:
 
 def _layout_text(layout: TextLayout) -> str:
     """A message's own text layout (`text:`), in words."""
-    fields = f"each field after {code_span(layout.separator)}"
-    if layout.named:
+    fields = (
+        f"each field after {code_span(layout.separator)}" if layout.separator else "each field right after the last"
+    )
+    if layout.glued:
+        fields += ", written as its label glued to its value and found by its label in any order (a label absent: None)"
+    elif layout.named:
         fields += (
             f", written as its label, {code_span(layout.named)} and its value and found by its label in any order "
             "(a label absent: None)"
         )
     values = f"; a repeat's values joined by {code_span(layout.list)}" if layout.list else ""
     end = f", then {code_span(layout.end)}" if layout.end else ""
+    if layout.after_code == "":
+        fields = "the first field right after the code, " + fields.replace("each field", "each other field")
+    elif layout.after_code is not None:
+        fields = f"the first field after {code_span(layout.after_code)}, " + fields.replace(
+            "each field", "each other field"
+        )
+    if not layout.start:
+        return f"Its own text inside the frame, found by its code: the code, {fields}{values}{end}."
     return f"Its own text inside the frame: {code_span(layout.start)}, the code, {fields}{values}{end}."
 
 
@@ -74,8 +89,9 @@ def _rows(message: TextMessage) -> Iterator[str]:
     index = 1
     for item in message.fields:
         # by position, or by label in a message's own text with `named`
-        first = code_span(item.label + layout.named) if layout is not None and layout.named else str(index)
-        if layout is not None and layout.named and item.label == message.code:
+        labelled = layout is not None and layout.labelled
+        first = code_span(item.label + (layout.named if layout else "")) if labelled else str(index)
+        if labelled and item.label == message.code:
             first += ", right after the code"  # the code's own value (GRBL's `Hold:0`)
         if isinstance(item, TextRepeat):
             times = f"{item.count} times" if item.count else f"up to {item.max_count} times, at the end"
@@ -109,7 +125,11 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         yield ""
     yield "| part | characters | meaning |"
     yield "| --- | --- | --- |"
-    yield f"| start | {code_span(frame.start)} | starts every frame |"
+    if frame.response_start:
+        starts = f"{code_span(frame.start)} or {code_span(frame.response_start)}"
+        yield f"| start | {starts} | starts a request or a response |"
+    else:
+        yield f"| start | {code_span(frame.start)} | starts every frame |"
     if frame.talker:
         talkers = ", ".join(frame.talkers) or "any"
         yield f"| talker | {frame.talker} characters | {cell(frame.talker_description)} ({talkers}) |"
@@ -117,8 +137,20 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
     yield f"| fields | each after {code_span(frame.separator)} | an empty field is None |"
     if frame.checksum is not None:
         optional = "" if frame.required else "; optional: a frame without it is accepted unchecked"
+        if frame.checksum_directions != ("request", "response"):
+            optional += f"; {' and '.join(d + 's' for d in frame.checksum_directions)} only"
+        if frame.checksum_separated:
+            names = " and ".join(d + "s" for d in frame.checksum_separated)
+            optional += f"; {names} write {code_span(frame.separator)} before the marker, covered by it"
+        match frame.checksum_format:
+            case "hex2":
+                written = f"{frame.digits} hex digits"
+            case "decimal":
+                written = "its value in decimal digits (0 to 255)"
+            case _:
+                assert_never(frame.checksum_format)
         yield (
-            f"| checksum | {code_span(frame.marker)} + {frame.digits} hex digits | "
+            f"| checksum | {code_span(frame.marker)} + {written} | "
             f"{cell(frame.checksum.describe())} between start and marker{optional} |"
         )
     yield f"| end | {_shown(frame.end)} | ends every frame (at most {frame.max_length} characters before it) |"
@@ -192,6 +224,7 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
 def _characters(frame: TextFrame, printed: str, fields: dict[str, object], bare: bool = False) -> Iterator[str]:
     """The printed frame cut into its parts: start, talker, code, each field, checksum, end (`bare`: a reply of
     values alone, its first part the first field)."""
+    start = printed[: len(frame.start)]  # the requests' or the responses' own
     body = printed[len(frame.start) :]
     checksum = ""
     if frame.checksum is not None and frame.marker in body:
@@ -199,7 +232,7 @@ def _characters(frame: TextFrame, printed: str, fields: dict[str, object], bare:
     parts = body.split(frame.separator)
     if bare:
         parts = ["", *parts]  # no code: the first part is a field's, written without a separator before it
-    yield f"| {code_span(frame.start)} | start |"
+    yield f"| {code_span(start)} | start |"
     if frame.talker and not bare:
         yield f"| {code_span(parts[0][: frame.talker])} | talker |"
     if not bare:

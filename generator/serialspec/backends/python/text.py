@@ -159,6 +159,10 @@ def _descriptor(f: TextField) -> str:
         arguments.append(f"letters={f.letters_class}")
     if f.label:
         arguments.append(f"label={f.label!r}")
+    if f.address:
+        arguments.append("address=True")
+    if f.rest:
+        arguments.append("rest=True")
     return f"TextField({', '.join(arguments)})"
 
 
@@ -242,11 +246,19 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield "#: The frame: start, talker and code, fields, checksum, line ending."
     yield "FRAMING = TextFraming("
     yield f"    start={text.start!r},"
+    if text.response_start:
+        yield f"    response_start={text.response_start!r},"
     yield f"    separator={text.separator!r},"
     yield f"    end={text.end!r},"
     yield f"    checksum={checksum},"
     yield f"    marker={text.marker!r},"
     yield f"    digits={text.digits},"
+    if text.checksum_format == "decimal":
+        yield "    decimal=True,"
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        yield f"    checksummed={text.checksum_directions!r},"
+    if text.checksum is not None and text.checksum_separated:
+        yield f"    separated={text.checksum_separated!r},"
     yield f"    required={text.required},"
     yield f"    talker={text.talker},"
     yield f"    talkers={text.talkers!r},"
@@ -269,9 +281,11 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         yield f"            name={message.code!r},"
         yield f"            direction={message.direction.value!r},"
         if message.layout is not None:
+            keys = ("start", "end", "separator", "named", "list", "after_code")
             shown = ", ".join(
-                f"{k}={getattr(message.layout, k)!r}" for k in ("start", "end", "separator", "named", "list")
+                f"{k}={getattr(message.layout, k)!r}" for k in keys if getattr(message.layout, k) is not None
             )
+            shown += ", glued=True" if message.layout.glued else ""
             yield f"            layout=TextLayout({shown}),"
         if message.values_only:
             yield "            bare=True,"
@@ -323,6 +337,9 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
                 yield from _attribute(item)
         yield "    #: How many fields the frame had (a decoded message encodes to the same text); -1: every field."
         yield "    sent: int = field(default=-1, compare=False, repr=False)"
+        if text.checksum is not None and not text.required and message.direction.value in text.checksum_directions:
+            yield "    #: Sent without its checksum (which may be left out): encoded again without it."
+            yield "    unchecked: bool = field(default=False, compare=False, repr=False)"
     yield ""
     yield ""
     names = ", ".join(m.class_name for m in text.messages)

@@ -241,7 +241,7 @@ def _text_example(package: ModuleType, text: TextFrame, example: TextExample) ->
     if found != recorded:
         return f"the frame decodes to other values: {_difference(found, recorded)}"
     encoded = package.encode(message)
-    if encoded != (example.printed + text.end).encode("ascii"):
+    if encoded != (example.printed + text.end).encode("latin-1"):
         return f"its values encode to {encoded!r}, not the frame"
     return ""
 

@@ -27,6 +27,8 @@ class TextField:
     letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
     letters_class: str = ""  # char with letters: the generated Enum's name
     label: str = ""  # in a message with its own text layout (`named`): the label its value follows
+    address: bool = False  # the framing's `address`: every message's first field, written before the code
+    rest: bool = False  # text `size: rest`: the rest of the line, separators included (the last field)
 
 
 @frozen
@@ -46,11 +48,18 @@ class TextLayout:
     """A message's own text inside the frame (`text:`): start + code + separated fields + end; with `named`, fields
     found by their labels (label, `named`, value), a repeat's values joined by `list`."""
 
-    start: str
+    start: str = ""
     end: str = ""
     separator: str = ","
     named: str = ""
     list: str = ""
+    after_code: str | None = None  # between the code and the first field (None: the separator; "": glued)
+    glued: bool = False  # labels glued to their values (`named: ""`): G-code's `X10.5`, LSS's `D1800T1500`
+
+    @property
+    def labelled(self) -> bool:
+        """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
+        return bool(self.named) or self.glued
 
 
 @frozen
@@ -131,6 +140,11 @@ class TextFrame:
     examples: tuple[TextExample, ...] = ()
     digits: int = 2
     device: TextDevice | None = None
+    checksum_format: Literal["hex2", "decimal"] = "hex2"  # how the checksum is written after the marker
+    checksum_directions: tuple[str, ...] = ("request", "response")  # the directions whose frames carry it
+    checksum_separated: tuple[str, ...] = ()  # the directions that write the separator before the marker
+    response_start: str = ""  # the responses' own start where it differs from the requests' (`start`): LSS's `*`
+    address: TextField | None = None  # every message's first field, its digits before the code (LSS's servo id)
 
     def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
         """The command's message in `direction` (its response by default: what a device sends)."""

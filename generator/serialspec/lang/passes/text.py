@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import string
 from dataclasses import replace
-from typing import Any, cast
+from typing import Any, Literal, cast
 
 from serialspec import checksums
 from serialspec.checksums import ChecksumProblem
@@ -37,13 +37,13 @@ KIND_KEYS = {
     "integer": {"width", "range"},
     "angle": {"precision", "width", "range"},
     "char": {"letters"},
-    "text": set(),
+    "text": {"size"},
     "time": {"precision"},
     "date": set(),
 }
 COMMON_KEYS = {"type", "use", "description", "unit", "label"}
 BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
-TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
+TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length", "address")
 NOT_YET = ("matching", "enums", "flags", "tables", "errata")
 # What a text device may say (the binary device's memory, ids, models and behaviours are not available yet)
 DEVICE_KEYS = ("description", "state", "reply", "sends", "commands")
@@ -86,6 +86,7 @@ class TextPass(Pass):
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
                 self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+        self.found_by_code(messages)
         responses = {m.key for m in messages if m.direction == Direction.RESPONSE}
         for message in messages:
             asked: Path = ("commands", message.key, "request", "answered_by")
@@ -114,17 +115,29 @@ class TextPass(Pass):
         for key in ("separator", "end"):
             if not raw.get(key):
                 self.error(path, f"missing key {key!r} (a text frame needs `separator` and `end`)")
-        start = str(raw.get("start") or "")  # none: every line is a frame
+        given = raw.get("start") or ""  # none: every line is a frame
+        start, response_start = str(given), ""
+        if isinstance(given, dict):  # one per direction: LSS's `#` requests and `*` replies
+            start, response_start = str(given.get("request") or ""), str(given.get("response") or "")
+            if not start or not response_start or start == response_start:
+                self.error((*path, "start"), "give each direction its own start, two different characters")
         separator, end = (str(raw.get(k) or "?") for k in ("separator", "end"))
-        if len(start) > 1 or len(separator) != 1:
+        if len(start) > 1 or len(response_start) > 1 or len(separator) != 1:
             self.error(path, "`start` (when given) and `separator` must be one character each")
         checksum_raw = raw.get("checksum")
         algorithm = None
         marker = "*"
         required = True
+        written: Literal["hex2", "decimal"] = "hex2"
+        carried: tuple[str, ...] = ("request", "response")
+        separated: tuple[str, ...] = ()
         if isinstance(checksum_raw, dict):
+            separated = tuple(d for d in ("request", "response") if d in (checksum_raw.get("separated") or ()))
+            if checksum_raw.get("directions"):
+                carried = tuple(d for d in ("request", "response") if d in checksum_raw["directions"])
             marker = str(checksum_raw.get("marker", "*"))
             required = bool(checksum_raw.get("required", True))
+            written = "decimal" if checksum_raw.get("format") == "decimal" else "hex2"
             where = (*path, "checksum")
             try:
                 algorithm = checksums.from_spec(checksum_raw, 1, "u8", lambda at, text: self.error((*where, *at), text))
@@ -138,7 +151,12 @@ class TextPass(Pass):
         for index, value in enumerate(talkers):
             if len(value) != size:
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
-        special = [*([start] if start else []), separator, *set(end)] + ([marker] if algorithm is not None else [])
+        if any(not " " <= c <= "~" for c in (start, response_start, separator) if c):
+            self.error(path, "`start` and `separator` are printable ASCII characters")
+        if any(c > "\xff" for c in end):
+            self.error((*path, "end"), "the line ending's characters are bytes: U+0000 to U+00FF (Nextion: \\xFF)")
+        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *set(end)]
+        special += [marker] if algorithm is not None else []
         if len(set(special)) != len(special):
             self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
         return TextFrame(
@@ -154,7 +172,28 @@ class TextPass(Pass):
             talker_description=str(talker.get("description", "")),
             max_length=int(raw.get("max_length", 82)),
             messages=(),
+            checksum_format=written,
+            checksum_directions=carried,
+            checksum_separated=separated,
+            response_start=response_start,
+            address=self.address(raw["address"]) if "address" in raw else None,
         )
+
+    def address(self, name: Any) -> TextField | None:
+        """`framing.address`: the shared integer field every message carries first, before its code."""
+        path: Path = ("framing", "address")
+        if str(name) not in self.shared_fields:
+            self.error(path, f"no shared field {name!r} in `fields:`")
+            return None
+        found = self.guard(path, self.field, str(name), str(name), path, True)
+        if found is None:
+            return None
+        if not isinstance(found, TextField) or found.kind != "integer":
+            self.error(path, f"the address {name!r} is an integer field (its digits are read before the code)")
+            return None
+        if found.minimum is not None and found.minimum < 0:
+            self.error(path, f"the address {name!r} is written as digits alone: its range starts at 0 or above")
+        return replace(found, address=True)
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
         path: Path = ("commands", key)
@@ -163,7 +202,11 @@ class TextPass(Pass):
                 self.error((*path, bad), f"`{bad}` is not available in text frames yet")
         code = command.get("code")
         # the framing's own characters would cut the code out of its frame (`$` starts NMEA sentences)
-        framing = {frame.start, frame.separator, frame.marker, *frame.end} - {""} if frame is not None else set()
+        framing = (
+            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end} - {""}
+            if frame is not None
+            else set()
+        )
         allowed = set(CODE_CHARACTERS) - framing
         if not isinstance(code, str) or not code or not set(code) <= allowed:
             shown = "".join(sorted(set(CODE_PUNCTUATION) - framing))
@@ -190,9 +233,13 @@ class TextPass(Pass):
                 f"{key} has a response of its own: leave out `answered_by` or the response",
             )
         fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
+        if frame is not None and frame.address is not None:  # every message's first field, before its code
+            if any(item.name == frame.address.name for item in fields):
+                self.error((*where, "fields", frame.address.name), "the framing's `address` is every message's already")
+            fields = (frame.address, *fields)
         layout = (
-            self.layout(raw["text"], code, fields, (*where, "text"), framing - {frame.separator} if frame else set())
-            if "text" in raw
+            self.layout(raw["text"], code, fields, (*where, "text"), frame)
+            if "text" in raw and isinstance(raw["text"], dict)
             else None
         )
         if layout is None:
@@ -226,30 +273,75 @@ class TextPass(Pass):
             values_only=values_only,
         )
 
+    def found_by_code(self, messages: list[TextMessage]) -> None:
+        """Each message found by its code alone (its own text without a `start`) is told from every other code: the
+        code and what follows it (`after_code`, else the separator) begin no other code, unless the code is glued
+        to a number and the other code goes on with no digit or sign (LSS's `Q6` beside `QD1800`)."""
+        codes = {m.code for m in messages}
+        for message in messages:
+            layout = message.layout
+            if layout is None or layout.start:
+                continue
+            after = layout.separator if layout.after_code is None else layout.after_code
+            sent = [f for f in message.fields if not (isinstance(f, TextField) and f.address)]
+            first = sent[0] if sent else None
+            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal")
+            for other in sorted(codes):
+                if other == message.code or not other.startswith(message.code + after):
+                    continue
+                if after == "" and numeric and other[len(message.code)] not in "0123456789+-.":
+                    continue
+                where = ("commands", message.key, message.direction.value, "text")
+                self.error(
+                    where,
+                    f"the code {message.code!r} then {after!r} begins the code {other!r}: a frame could be either"
+                    + (" (glue only a number to a code another code begins with)" if after == "" else ""),
+                )
+
     def layout(
-        self, raw: dict[str, Any], code: str, fields: tuple[TextField | TextRepeat, ...], path: Path, framing: set[str]
+        self,
+        raw: dict[str, Any],
+        code: str,
+        fields: tuple[TextField | TextRepeat, ...],
+        path: Path,
+        frame: TextFrame | None,
     ) -> TextLayout:
         """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
-        layout = TextLayout(**{k: str(raw[k]) for k in ("start", "end", "separator", "named", "list") if k in raw})
-        if not layout.start or layout.start[0] in CODE_CHARACTERS:
+        framing = {frame.start, frame.response_start, frame.marker, *frame.end} - {""} if frame is not None else set()
+        given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
+        given.setdefault("separator", frame.separator if frame is not None else ",")
+        glued = given.get("named") == ""  # labels glued to their values: G-code's `X10.5`, LSS's `D1800T1500`
+        layout = TextLayout(**given, glued=glued)
+        fields = tuple(f for f in fields if not (isinstance(f, TextField) and f.address))  # the address: before
+        if layout.start and layout.start[0] in CODE_CHARACTERS:
             self.error((*path, "start"), "a message's text starts with a character no text code has (GRBL: `<`)")
         for key in ("separator", "named", "list"):
             value = getattr(layout, key)
-            if key in raw and len(value) != 1:
+            if key in raw and len(value) != 1 and not (glued and key in ("named", "separator") and value == ""):
                 self.error((*path, key), f"`{key}` is one character")
+        if glued:
+            self.glued(layout, code, fields, path)
+        if layout.after_code is not None and len(layout.after_code) > 1:
+            self.error((*path, "after_code"), "`after_code` is one character, or empty (the value glued to the code)")
         single = [c for c in (layout.separator, layout.named, layout.list) if c]
         if len(set(single)) != len(single) or set(single) & framing:
             self.error(path, "`separator`, `named` and `list` differ from each other and from the framing's characters")
-        if set(code) & set(single):
+        if set(layout.after_code or "") & framing:
+            self.error((*path, "after_code"), "`after_code` differs from the framing's characters")
+        if set(code) & set(single + [layout.after_code or ""]) - {""}:
             self.error(path, f"the code {code!r} holds one of the message's own characters")
+        if not layout.start and not glued and any(item.label == code for item in fields):
+            self.error(path, "a field labelled with the code needs the message's own `start`")
         for item in fields:
             where = (*path[:-1], "fields", item.name)
-            if layout.named and not item.label:
+            if layout.labelled and not item.label:
                 self.error(where, "with `text.named` every field needs a `label`")
-            if isinstance(item, TextRepeat) and not layout.list:
-                self.error(where, "a repeat in a message's own text needs `text.list` between its values")
+            if isinstance(item, TextRepeat) and layout.named and not layout.list:
+                self.error(where, "a labelled repeat needs `text.list` between its values")
             if isinstance(item, TextRepeat) and any(f.label for f in item.fields):
                 self.error(where, "a label goes on the repeat, not on its fields")
+            if isinstance(item, TextField) and item.rest and (layout.labelled or layout.list):
+                self.error((*where, "size"), "the rest of the line in a message whose fields have labels or lists")
             if isinstance(item, TextRepeat) and item.label == code:
                 self.error((*where, "label"), "the field after the code (labelled with the code) is one value")
         labels = [item.label for item in fields if item.label]
@@ -260,6 +352,24 @@ class TextPass(Pass):
                 self.error((*path[:-1], "fields"), f"label {label!r} holds a character the message's text uses")
         return layout
 
+    def glued(self, layout: TextLayout, code: str, fields: tuple[TextField | TextRepeat, ...], path: Path) -> None:
+        """Labels glued to their values (`named: ""`): a message found by its code, each value told by its label
+        (the longest that fits), and without a separator each value a number (it ends where a label begins)."""
+        if layout.start:
+            self.error((*path, "named"), 'labels glued to their values (`named: ""`) need a message found by its code')
+        labels = [item.label for item in fields if item.label]
+        for item in fields:
+            where = (*path[:-1], "fields", item.name)
+            if isinstance(item, TextRepeat):
+                self.error(where, 'a repeat in a message whose labels are glued to their values (`named: ""`)')
+            elif not layout.separator and item.kind not in ("integer", "decimal"):
+                self.error(where, "without a separator, a value glued between labels is a number (integer, decimal)")
+        for label in labels:
+            if any(other != label and other.startswith(label) for other in labels):
+                self.error((*path[:-1], "fields"), f"label {label!r} begins another label: a value could follow either")
+            if not layout.separator and (not label or set(label) & set("0123456789+-.")):
+                self.error((*path[:-1], "fields"), f"label {label!r} holds a number's character: it could be a value")
+
     def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:
         found: list[TextField | TextRepeat] = []
         for name, value in raw.items():
@@ -269,6 +379,9 @@ class TextPass(Pass):
         variable = [i for i, f in enumerate(found) if isinstance(f, TextRepeat) and not f.count]
         if variable and variable[0] != len(found) - 1:
             self.error((*path, found[variable[0]].name), "a repeat with `max_count` must be the last field")
+        rest = [i for i, f in enumerate(found) if isinstance(f, TextField) and f.rest]
+        if rest and rest[0] != len(found) - 1:
+            self.error((*path, found[rest[0]].name, "size"), "the rest of the line (`size: rest`) is the last field")
         return tuple(found)
 
     def field(self, name: str, value: Any, path: Path, top: bool) -> TextField | TextRepeat:
@@ -331,7 +444,18 @@ class TextPass(Pass):
             letters=letters,
             letters_class=letters_class,
             label=str(spec.get("label", "")),
+            rest=self.rest(spec, path, top),
         )
+
+    def rest(self, spec: dict[str, Any], path: Path, top: bool) -> bool:
+        """A text field's `size: rest`: the rest of the line, separators included (the last field of a message)."""
+        if "size" not in spec:
+            return False
+        if spec["size"] != "rest":
+            self.error((*path, "size"), "a text field's size is `rest` (the rest of the line), or not given")
+        elif not top:
+            self.error((*path, "size"), "the rest of the line is a message's last field, not a repeat's")
+        return spec["size"] == "rest" and top
 
     def device(self, raw: dict[str, Any], frame: TextFrame) -> TextDevice:
         """`device:` the state, the values every sentence carries and the sentences sent on their own."""
@@ -472,6 +596,13 @@ class TextPass(Pass):
                 else:
                     echoes.append(str(name))
             found.append(TextAnswer(str(key), str(item.get("description", "")), stores, sets, reports, tuple(echoes)))
+        if frame.address is not None:  # every answer carries the request's address (the servo asked answers)
+            name = frame.address.name
+            found = [replace(a, echoes=(name, *a.echoes)) if name not in a.echoes else a for a in found]
+            entries = {a.command for a in found}
+            for request in frame.messages:
+                if request.direction == Direction.REQUEST and request.key not in entries and frame.answer(request):
+                    found.append(TextAnswer(request.key, echoes=(name,)))
         return tuple(found)
 
     def examples(self, frame: TextFrame) -> list[TextExample]:

@@ -244,3 +244,22 @@ def test_every_verb_that_takes_a_spec_says_a_package_name_works_too() -> None:
             main([verb, "--help"])
         text = " ".join(out.getvalue().split())
         assert "or a generated protocol package's name" in text, verb
+
+
+def test_the_site_takes_a_link_to_a_folder_as_its_readme(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A link to a folder (GitHub shows its README) made the site's build stop with IsADirectoryError (copied as a
+    file); now it links the folder's README, and a folder without one is left to mkdocs' strict check."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docsite_tool", ROOT / "tools" / "docsite.py")
+    assert spec is not None and spec.loader is not None
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    (tmp_path / "examples").mkdir()
+    (tmp_path / "examples" / "README.md").write_text("# Examples\n", encoding="utf-8")
+    (tmp_path / "specs").mkdir()
+    (tmp_path / "README.md").write_text("[the examples](examples/) and [the specs](specs/)\n", encoding="utf-8")
+    monkeypatch.setattr(tool, "ROOT", tmp_path)
+    texts, files = tool.relinked({"README.md": "index.md"})
+    assert texts["index.md"] == "[the examples](examples/README.md) and [the specs](specs/)\n"
+    assert files == {"examples/README.md": tmp_path / "examples" / "README.md"}

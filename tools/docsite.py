@@ -48,8 +48,10 @@ def relinked(mapping: dict[str, str]) -> tuple[dict[str, str], dict[str, Path]]:
 
         def relink(match: re.Match[str], here: Path = here, target: str = target) -> str:
             linked = os.path.normpath(here / match.group(2))
-            if not (ROOT / linked).exists():
-                return match.group(0)  # mkdocs reports it (strict: the build fails)
+            if (ROOT / linked).is_dir() and (ROOT / linked / "README.md").is_file():
+                linked = os.path.join(linked, "README.md")  # a folder: its README, as GitHub shows it
+            if not (ROOT / linked).is_file():
+                return match.group(0)  # mkdocs reports it (strict: the build fails), a folder too
             if linked not in mapping:
                 files[linked] = ROOT / linked
             relative = os.path.relpath(mapping.get(linked, linked), Path(target).parent)

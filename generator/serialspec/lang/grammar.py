@@ -615,7 +615,8 @@ MESSAGE = Obj(
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
             "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
-            "under the header's `error_value` (MSP's `$M!`). Its message carries the code of the refused request "
+            "under the header's `error_value` (MSP's `$M!`), or with the status element's `error_bits` set (SHDLC's "
+            "state byte). Its message carries the code of the refused request "
             "in a value named after the command element; clients raise DeviceError for it."
         ),
         "optional_when": OPTIONAL_WHEN,
@@ -1046,6 +1047,12 @@ FRAME_ELEMENT = Obj(
         "error_flag": Int(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
+        ),
+        "error_bits": Int(
+            "status: bits whose being set in a reply's status make it an error reply (SHDLC: 0x7F, the execution "
+            "error code of the state byte); such a reply carries the refused request's code in the command element, "
+            "its status as it is, and its content is that of the command whose response is the `error_reply`; a "
+            "reply whose status has none of them is the command's own."
         ),
         "error_value": Str(
             "header: the bytes a response starts with instead of its `value` when it refuses the request (MSP: "

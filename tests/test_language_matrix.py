@@ -515,7 +515,9 @@ class Built:
 
 
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
-C_REFUSES: dict[str, str] = {}
+C_REFUSES: dict[str, str] = {
+    "frame: error status (error_bits), an error reply without fields": "error replies told by their status",
+}
 
 
 # Cases the Wireshark target refuses (backends.Unsupported), with the one line it says.
@@ -661,6 +663,29 @@ CASES["frame: error header (error_value), an error reply without fields"] = Case
             "code": {"role": "command", "type": "u8"},
             "content": {"role": "content"},
             "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["length", "content"]},
+        }
+    },
+    {"refused": {"response": {"error_reply": True, "fields": {}}}},
+)
+# an error reply told by its status (SHDLC's state byte, its execution error code 6..0): the refused code in the
+# command element as it is, no content; a status with bit 7 alone is a normal reply
+CASES["frame: error status (error_bits), an error reply without fields"] = Case(
+    {"v": "u8"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": "7E"},
+            "code": {"role": "command", "type": "u8"},
+            "state": {
+                "role": "status",
+                "type": "u8",
+                "directions": ["response"],
+                "error_bits": 0x7F,
+                "bits": {"alert": {"bits": 7}, "error": {"bits": [6, 0]}},
+            },
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
         }
     },
     {"refused": {"response": {"error_reply": True, "fields": {}}}},

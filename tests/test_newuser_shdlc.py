@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
 import struct
 import threading
 import tty
@@ -239,3 +240,42 @@ def test_an_error_state_reply_without_data(sp: ModuleType) -> None:
         sp.encode(sp.ReadVersionResponse(0, message.state, 2, 1, 7, 2, 0))
     with pytest.raises(EncodeError, match="one of the error bits 0x7f"):
         sp.encode(sp.RefusedResponse(address=0, state=normal.state, command=0xD1))
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        (
+            "error_bits: 0x7F",
+            "error_bits: 0x180",
+            "the error bits must be a non-zero bit mask that fits the status's 8",
+        ),
+        ("error_bits: 0x7F", "error_bits: 0", "the error bits must be a non-zero bit mask"),
+        (
+            "command: {role: command, type: u8}",
+            "command: {role: command, type: u8, error_bits: 1}",
+            "goes on the status",
+        ),
+        ("command: {role: command, type: u8}", "command: {role: command, type: u8, error_flag: 0x80}", "give either"),
+        (
+            "  refused:\n",
+            "  refused_not:\n",
+            "`error_bits` needs a command whose response is marked `error_reply: true`",
+        ),
+    ],
+)
+def test_error_bits_misused_is_one_line(tmp_path: Path, old: str, new: str, said: str) -> None:
+    """`error_bits` elsewhere than on the status, a mask that does not fit it, beside `error_flag`, or without an
+    `error_reply`: one line with file:line:column each."""
+    text = SPEC.read_text()
+    assert old in text
+    spec = tmp_path / "bad.yaml"
+    text = text.replace(old, new)
+    if new.startswith("  refused_not"):  # the command gone, not only its mark
+        text = text[: text.index("  refused_not:")] + text[text.index("  device_reset:") :]
+    spec.write_text(text)
+    with pytest.raises(SpecErrors) as refused:
+        load_protocol(spec)
+    lines = str(refused.value).splitlines()
+    assert len(lines) == 1 and said in lines[0], lines
+    assert re.match(r"\S*bad\.yaml:\d+:\d+: framing\.elements\.\w+\.error_", lines[0]), lines

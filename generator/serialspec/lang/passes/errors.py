@@ -89,15 +89,16 @@ class ErrorReplies(Pass):
     ) -> list[SpecError]:
         """Error replies told by their status (`error_bits`: SHDLC's state byte): the `error_reply` response is their
         content, the command element carries the refused request's code as it is."""
+        for other, item in status:
+            if item.get("role") != "status":
+                self.error(("framing", "elements", other, "error_bits"), "`error_bits` goes on the status element")
+        status = [(other, item) for other, item in status if item.get("role") == "status"]
+        if not status:
+            return self.problems
         name, element = status[0]
         path = ("framing", "elements", name, "error_bits")
         for other, _ in status[1:]:
-            self.error(
-                ("framing", "elements", other, "error_bits"), f"only one status marks error replies: {name!r} does"
-            )
-        if element.get("role") != "status":
-            self.error(path, "`error_bits` goes on the status element")
-            return self.problems
+            self.error(("framing", "elements", other, "error_bits"), f"only one status marks error replies: {name!r}")
         for other, _ in flagged:
             self.error(
                 ("framing", "elements", other, "error_flag"), "give either `error_flag` or the status's `error_bits`"

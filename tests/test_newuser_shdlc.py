@@ -271,6 +271,7 @@ def test_error_bits_misused_is_one_line(tmp_path: Path, old: str, new: str, said
     assert old in text
     spec = tmp_path / "bad.yaml"
     text = text.replace(old, new)
+    text = text[: text.index("device:\n")] + text[text.index("examples:\n") :]  # its errors need the error reply
     if new.startswith("  refused_not"):  # the command gone, not only its mark
         text = text[: text.index("  refused_not:")] + text[text.index("  device_reset:") :]
     spec.write_text(text)
@@ -279,3 +280,15 @@ def test_error_bits_misused_is_one_line(tmp_path: Path, old: str, new: str, said
     lines = str(refused.value).splitlines()
     assert len(lines) == 1 and said in lines[0], lines
     assert re.match(r"\S*bad\.yaml:\d+:\d+: framing\.elements\.\w+\.error_", lines[0]), lines
+
+
+def test_the_simulator_refuses_an_unknown_command_in_the_state_byte(sp: ModuleType) -> None:
+    """A request of code 0x44 (no command has it) is answered as a real SPS30 does: no data, state 0x02 (unknown
+    command), the request's code in the command byte; the peer's MISO reader takes the frame apart the same way."""
+    simulator = importlib.import_module(f"{sp.__name__}.simulator").ShdlcSps30Simulator(ids=[0])
+    ((_, frame),) = simulator.feed(Mosi(0, 0x44, b"").to_bytes())
+    assert frame == miso_frame(0, 0x44, 0x02, b"")
+    assert peer_reads(frame) == (0, 0x44, 0x02, b"")
+    reply = sp.decode(frame, sp.Direction.RESPONSE)
+    assert isinstance(reply, sp.RefusedResponse) and reply.command == 0x44
+    assert reply.state.code == sp.ExecutionError.UNKNOWN_COMMAND

@@ -229,6 +229,9 @@ def test_an_error_state_reply_without_data(sp: ModuleType) -> None:
     message = sp.decode(frame, sp.Direction.RESPONSE)
     assert isinstance(message, sp.RefusedResponse)
     assert int(message.state.code) == 0x43 and message.command == 0xD1 and message.address == 0
+    example = next(e for e in load_protocol(SPEC).examples if e.name == "read_version_refused")  # the spec's own
+    assert (example.frame, example.command) == (frame, "refused")
+    assert sp.RefusedResponse.from_fields(example.fields) == message
     assert sp.encode(message) == frame
     version = miso_frame(0, 0xD1, 0x80, bytes([2, 1, 0, 7, 0, 2, 0]))  # bit 7 (device error) alone: a normal reply
     normal = sp.decode(version, sp.Direction.RESPONSE)
@@ -274,6 +277,7 @@ def test_error_bits_misused_is_one_line(tmp_path: Path, old: str, new: str, said
     text = text[: text.index("device:\n")] + text[text.index("examples:\n") :]  # its errors need the error reply
     if new.startswith("  refused_not"):  # the command gone, not only its mark
         text = text[: text.index("  refused_not:")] + text[text.index("  device_reset:") :]
+        text = text[: text.index("  read_version_refused:")]  # and its example
     spec.write_text(text)
     with pytest.raises(SpecErrors) as refused:
         load_protocol(spec)

@@ -217,8 +217,6 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of a binary spec the C target cannot generate yet (a text spec's:
     text.refuse)."""
     refuse_by_request(protocol)
-    if protocol.error_reply is not None and protocol.error_reply.status:
-        raise Unsupported(f"error replies told by their status (`error_bits` on {protocol.error_reply.status!r})")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

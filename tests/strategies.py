@@ -10,6 +10,7 @@ from serialspec.lang.model import (
     Array,
     BitField,
     Bytes,
+    Direction,
     Field,
     Group,
     List,
@@ -185,9 +186,27 @@ def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[di
         }
         | refused_code(protocol, message)
     )
+    error = protocol.error_reply
+    if error is not None and error.status and message.direction == Direction.RESPONSE:
+        # told by the status (`error_bits`): the error reply has one of them set, every other reply none
+        element = next(e for e in frame if e.name == error.status)
+        bits, refusing = error.bits, message.error_reply
+        frame_values = frame_values.map(
+            lambda values: {**values, element.name: status_told(element, values[element.name], bits, refusing)}
+        )
     drawn = st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})
     optional = protocol.framing.layouts[message.direction].optional
     return drawn.flatmap(lambda fields: optional_values(fields, optional)) if optional else drawn
+
+
+def status_told(element: Any, value: Any, bits: int, error_reply: bool) -> Any:
+    """A status drawn, its error `bits` cleared for a reply; for the error reply, the lowest set where none is."""
+    wire = sum((int(value[b.name]) & b.mask) << b.low for b in element.bits) if element.bits else int(value)
+    if not error_reply:
+        wire &= ~bits
+    elif not wire & bits:
+        wire |= bits & -bits
+    return {b.name: wire >> b.low & b.mask for b in element.bits} if element.bits else wire
 
 
 def optional_values(fields: dict[str, Any], optional: tuple[Any, ...]) -> st.SearchStrategy[dict[str, Any]]:

@@ -682,6 +682,29 @@ CASES["frame: error header (error_value), an error reply without fields"] = Case
     },
     {"refused": {"response": {"error_reply": True, "fields": {}}}},
 )
+# an error reply told by its status (SHDLC's state byte, its execution error code 6..0): the refused code in the
+# command element as it is, no content; a status with bit 7 alone is a normal reply
+CASES["frame: error status (error_bits), an error reply without fields"] = Case(
+    {"v": "u8"},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": "7E"},
+            "code": {"role": "command", "type": "u8"},
+            "state": {
+                "role": "status",
+                "type": "u8",
+                "directions": ["response"],
+                "error_bits": 0x7F,
+                "bits": {"alert": {"bits": 7}, "error": {"bits": [6, 0]}},
+            },
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        }
+    },
+    {"refused": {"response": {"error_reply": True, "fields": {}}}},
+)
 # MSP v1 beside v2: layouts told apart by header with different element orders and checksums, and a code only
 # the second layout's u16 command element holds (encode sends it there; a code both hold goes in the first)
 CASES["frame: layouts, a code only a later layout's command element holds"] = Case(

@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } crsf__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -548,6 +550,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
     int bounded = 0;
     uint8_t k, first = crsf__inner_first(L);
     long code = CRSF__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return CRSF__WAIT;
     }
@@ -565,7 +568,7 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
             uint32_t value = crsf__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? CRSF__ERROR_CODE : (long)value;
-            if (!crsf__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !crsf__bounds(dir, code, &low, &high, &bounded)) {
                 return CRSF__NONE;
             }
         } else if (e->role == CRSF__ROLE_VALUE) {
@@ -573,8 +576,17 @@ static long crsf__probe(const crsf__layout_t *L, crsf_direction_t dir, const uin
             if (!(CRSF__PLAUSIBLE(e, value))) {
                 return CRSF__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != CRSF__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? CRSF__ERROR_CODE : code;
+        if (!crsf__bounds(dir, code, &low, &high, &bounded)) {
+            return CRSF__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -650,7 +662,7 @@ static const crsf__element_t crsf__l_request_0_e[] = {
     {CRSF__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {CRSF__ROLE_CHECKSUM, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const crsf__layout_t crsf__l_request_0 = {crsf__l_request_0_e, 5u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 4u, 3u, 1u, 1, 1u, 2u};
+static const crsf__layout_t crsf__l_request_0 = {crsf__l_request_0_e, 5u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 4u, 3u, 1u, 1, 1u, 2u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t crsf__l_response_0_c0[] = {0xc8u};
@@ -661,7 +673,7 @@ static const crsf__element_t crsf__l_response_0_e[] = {
     {CRSF__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {CRSF__ROLE_CHECKSUM, 1u, 0u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const crsf__layout_t crsf__l_response_0 = {crsf__l_response_0_e, 5u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 4u, 3u, 1u, 1, 1u, 2u};
+static const crsf__layout_t crsf__l_response_0 = {crsf__l_response_0_e, 5u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 4u, 3u, 1u, 1, 1u, 2u, -1, 0UL};
 
 static const crsf__layout_t *const crsf__layouts_request[] = {&crsf__l_request_0};
 static const crsf__layout_t *const crsf__layouts_response[] = {&crsf__l_response_0};

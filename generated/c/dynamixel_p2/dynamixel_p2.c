@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } dynamixel_p2__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -548,6 +550,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
     int bounded = 0;
     uint8_t k, first = dynamixel_p2__inner_first(L);
     long code = DYNAMIXEL_P2__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return DYNAMIXEL_P2__WAIT;
     }
@@ -565,7 +568,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
             uint32_t value = dynamixel_p2__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? DYNAMIXEL_P2__ERROR_CODE : (long)value;
-            if (!dynamixel_p2__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !dynamixel_p2__bounds(dir, code, &low, &high, &bounded)) {
                 return DYNAMIXEL_P2__NONE;
             }
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
@@ -573,8 +576,17 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
             if (!(DYNAMIXEL_P2__PLAUSIBLE(e, value))) {
                 return DYNAMIXEL_P2__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != DYNAMIXEL_P2__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? DYNAMIXEL_P2__ERROR_CODE : code;
+        if (!dynamixel_p2__bounds(dir, code, &low, &high, &bounded)) {
+            return DYNAMIXEL_P2__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -659,7 +671,7 @@ static const uint8_t dynamixel_p2__l_request_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xfd
 static const dynamixel_p2__pair_t dynamixel_p2__l_request_0_pairs[] = {
     {dynamixel_p2__l_request_0_p0, dynamixel_p2__l_request_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u, 0UL, 10u, 7u, 2u, 3, 5u, 3u};
+static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u, 0UL, 10u, 7u, 2u, 3, 5u, 3u, -1, 0UL};
 
 /* The response frame. */
 /* Byte stuffing (protocol2 §Packet Process): from the instruction to the last parameter, every FF FF FD is sent as FF FF FD FD, so the header appears nowhere else in a packet. */
@@ -681,7 +693,7 @@ static const uint8_t dynamixel_p2__l_response_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xf
 static const dynamixel_p2__pair_t dynamixel_p2__l_response_0_pairs[] = {
     {dynamixel_p2__l_response_0_p0, dynamixel_p2__l_response_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u, 0UL, 11u, 7u, 2u, 3, 5u, 4u};
+static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u, 0UL, 11u, 7u, 2u, 3, 5u, 4u, -1, 0UL};
 
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_request[] = {&dynamixel_p2__l_request_0};
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_response[] = {&dynamixel_p2__l_response_0};

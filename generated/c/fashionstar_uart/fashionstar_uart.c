@@ -137,6 +137,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } fashionstar_uart__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -544,6 +546,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
     int bounded = 0;
     uint8_t k, first = fashionstar_uart__inner_first(L);
     long code = FASHIONSTAR_UART__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return FASHIONSTAR_UART__WAIT;
     }
@@ -561,7 +564,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
             uint32_t value = fashionstar_uart__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? FASHIONSTAR_UART__ERROR_CODE : (long)value;
-            if (!fashionstar_uart__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !fashionstar_uart__bounds(dir, code, &low, &high, &bounded)) {
                 return FASHIONSTAR_UART__NONE;
             }
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
@@ -569,8 +572,17 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
             if (!(FASHIONSTAR_UART__PLAUSIBLE(e, value))) {
                 return FASHIONSTAR_UART__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != FASHIONSTAR_UART__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? FASHIONSTAR_UART__ERROR_CODE : code;
+        if (!fashionstar_uart__bounds(dir, code, &low, &high, &bounded)) {
+            return FASHIONSTAR_UART__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -646,7 +658,7 @@ static const fashionstar_uart__element_t fashionstar_uart__l_request_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const fashionstar_uart__layout_t fashionstar_uart__l_request_0 = {fashionstar_uart__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
+static const fashionstar_uart__layout_t fashionstar_uart__l_request_0 = {fashionstar_uart__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t fashionstar_uart__l_response_0_c0[] = {0x05u, 0x1cu};
@@ -657,7 +669,7 @@ static const fashionstar_uart__element_t fashionstar_uart__l_response_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const fashionstar_uart__layout_t fashionstar_uart__l_response_0 = {fashionstar_uart__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
+static const fashionstar_uart__layout_t fashionstar_uart__l_response_0 = {fashionstar_uart__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u, -1, 0UL};
 
 static const fashionstar_uart__layout_t *const fashionstar_uart__layouts_request[] = {&fashionstar_uart__l_request_0};
 static const fashionstar_uart__layout_t *const fashionstar_uart__layouts_response[] = {&fashionstar_uart__l_response_0};

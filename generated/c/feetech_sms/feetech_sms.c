@@ -137,6 +137,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } feetech_sms__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -544,6 +546,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
     int bounded = 0;
     uint8_t k, first = feetech_sms__inner_first(L);
     long code = FEETECH_SMS__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return FEETECH_SMS__WAIT;
     }
@@ -561,7 +564,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
             uint32_t value = feetech_sms__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? FEETECH_SMS__ERROR_CODE : (long)value;
-            if (!feetech_sms__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !feetech_sms__bounds(dir, code, &low, &high, &bounded)) {
                 return FEETECH_SMS__NONE;
             }
         } else if (e->role == FEETECH_SMS__ROLE_VALUE) {
@@ -569,8 +572,17 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
             if (!(FEETECH_SMS__PLAUSIBLE(e, value))) {
                 return FEETECH_SMS__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != FEETECH_SMS__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? FEETECH_SMS__ERROR_CODE : code;
+        if (!feetech_sms__bounds(dir, code, &low, &high, &bounded)) {
+            return FEETECH_SMS__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -647,7 +659,7 @@ static const feetech_sms__element_t feetech_sms__l_request_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u, 0UL, 6u, 5u, 1u, 2, 3u, 0u};
+static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u, 0UL, 6u, 5u, 1u, 2, 3u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t feetech_sms__l_response_0_c0[] = {0xffu, 0xffu};
@@ -659,7 +671,7 @@ static const feetech_sms__element_t feetech_sms__l_response_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 6u, 5u, 1u, 2, 3u, 0u};
+static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 6u, 5u, 1u, 2, 3u, 0u, -1, 0UL};
 
 static const feetech_sms__layout_t *const feetech_sms__layouts_request[] = {&feetech_sms__l_request_0};
 static const feetech_sms__layout_t *const feetech_sms__layouts_response[] = {&feetech_sms__l_response_0};

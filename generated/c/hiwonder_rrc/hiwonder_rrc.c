@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } hiwonder_rrc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -548,6 +550,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
     int bounded = 0;
     uint8_t k, first = hiwonder_rrc__inner_first(L);
     long code = HIWONDER_RRC__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return HIWONDER_RRC__WAIT;
     }
@@ -565,7 +568,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             uint32_t value = hiwonder_rrc__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? HIWONDER_RRC__ERROR_CODE : (long)value;
-            if (!hiwonder_rrc__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !hiwonder_rrc__bounds(dir, code, &low, &high, &bounded)) {
                 return HIWONDER_RRC__NONE;
             }
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
@@ -573,8 +576,17 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             if (!(HIWONDER_RRC__PLAUSIBLE(e, value))) {
                 return HIWONDER_RRC__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != HIWONDER_RRC__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? HIWONDER_RRC__ERROR_CODE : code;
+        if (!hiwonder_rrc__bounds(dir, code, &low, &high, &bounded)) {
+            return HIWONDER_RRC__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -650,7 +662,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_request_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t hiwonder_rrc__l_response_0_c0[] = {0xaau, 0x55u};
@@ -661,7 +673,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_response_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u, -1, 0UL};
 
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_request[] = {&hiwonder_rrc__l_request_0};
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_response[] = {&hiwonder_rrc__l_response_0};

@@ -187,6 +187,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } mavlink_common__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -594,6 +596,7 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
     int bounded = 0;
     uint8_t k, first = mavlink_common__inner_first(L);
     long code = MAVLINK_COMMON__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return MAVLINK_COMMON__WAIT;
     }
@@ -611,7 +614,7 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
             uint32_t value = mavlink_common__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? MAVLINK_COMMON__ERROR_CODE : (long)value;
-            if (!mavlink_common__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !mavlink_common__bounds(dir, code, &low, &high, &bounded)) {
                 return MAVLINK_COMMON__NONE;
             }
         } else if (e->role == MAVLINK_COMMON__ROLE_VALUE) {
@@ -619,8 +622,17 @@ static long mavlink_common__probe(const mavlink_common__layout_t *L, mavlink_com
             if (!(MAVLINK_COMMON__PLAUSIBLE(e, value))) {
                 return MAVLINK_COMMON__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != MAVLINK_COMMON__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? MAVLINK_COMMON__ERROR_CODE : code;
+        if (!mavlink_common__bounds(dir, code, &low, &high, &bounded)) {
+            return MAVLINK_COMMON__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -706,7 +718,7 @@ static const mavlink_common__element_t mavlink_common__l_request_0_e[] = {
     {MAVLINK_COMMON__ROLE_CHECKSUM, 2u, 0u, 1u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
     {MAVLINK_COMMON__ROLE_EXTRA, 13u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* signature */
 };
-static const mavlink_common__layout_t mavlink_common__l_request_0 = {mavlink_common__l_request_0_e, 12u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 25u, 10u, 15u, 1, 1u, 0u};
+static const mavlink_common__layout_t mavlink_common__l_request_0 = {mavlink_common__l_request_0_e, 12u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 25u, 10u, 15u, 1, 1u, 0u, -1, 0UL};
 
 /* The request frame. */
 static const uint8_t mavlink_common__l_request_1_c0[] = {0xfdu};
@@ -726,7 +738,7 @@ static const mavlink_common__element_t mavlink_common__l_request_1_e[] = {
     {MAVLINK_COMMON__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {MAVLINK_COMMON__ROLE_CHECKSUM, 2u, 0u, 1u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const mavlink_common__layout_t mavlink_common__l_request_1 = {mavlink_common__l_request_1_e, 11u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 12u, 10u, 2u, 1, 1u, 0u};
+static const mavlink_common__layout_t mavlink_common__l_request_1 = {mavlink_common__l_request_1_e, 11u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 12u, 10u, 2u, 1, 1u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t mavlink_common__l_response_0_c0[] = {0xfdu};
@@ -747,7 +759,7 @@ static const mavlink_common__element_t mavlink_common__l_response_0_e[] = {
     {MAVLINK_COMMON__ROLE_CHECKSUM, 2u, 0u, 1u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
     {MAVLINK_COMMON__ROLE_EXTRA, 13u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* signature */
 };
-static const mavlink_common__layout_t mavlink_common__l_response_0 = {mavlink_common__l_response_0_e, 12u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 25u, 10u, 15u, 1, 1u, 0u};
+static const mavlink_common__layout_t mavlink_common__l_response_0 = {mavlink_common__l_response_0_e, 12u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 25u, 10u, 15u, 1, 1u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t mavlink_common__l_response_1_c0[] = {0xfdu};
@@ -767,7 +779,7 @@ static const mavlink_common__element_t mavlink_common__l_response_1_e[] = {
     {MAVLINK_COMMON__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {MAVLINK_COMMON__ROLE_CHECKSUM, 2u, 0u, 1u, 9u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const mavlink_common__layout_t mavlink_common__l_response_1 = {mavlink_common__l_response_1_e, 11u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 12u, 10u, 2u, 1, 1u, 0u};
+static const mavlink_common__layout_t mavlink_common__l_response_1 = {mavlink_common__l_response_1_e, 11u, 9, 7, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 12u, 10u, 2u, 1, 1u, 0u, -1, 0UL};
 
 static const mavlink_common__layout_t *const mavlink_common__layouts_request[] = {&mavlink_common__l_request_0, &mavlink_common__l_request_1};
 static const mavlink_common__layout_t *const mavlink_common__layouts_response[] = {&mavlink_common__l_response_0, &mavlink_common__l_response_1};

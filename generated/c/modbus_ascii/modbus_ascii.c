@@ -137,6 +137,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } modbus_ascii__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -606,6 +608,7 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
     int bounded = 0;
     uint8_t k, first = modbus_ascii__inner_first(L);
     long code = MODBUS_ASCII__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return MODBUS_ASCII__WAIT;
     }
@@ -623,7 +626,7 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
             uint32_t value = modbus_ascii__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? MODBUS_ASCII__ERROR_CODE : (long)value;
-            if (!modbus_ascii__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !modbus_ascii__bounds(dir, code, &low, &high, &bounded)) {
                 return MODBUS_ASCII__NONE;
             }
         } else if (e->role == MODBUS_ASCII__ROLE_VALUE) {
@@ -631,8 +634,17 @@ static long modbus_ascii__probe(const modbus_ascii__layout_t *L, modbus_ascii_di
             if (!(MODBUS_ASCII__PLAUSIBLE(e, value))) {
                 return MODBUS_ASCII__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != MODBUS_ASCII__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? MODBUS_ASCII__ERROR_CODE : code;
+        if (!modbus_ascii__bounds(dir, code, &low, &high, &bounded)) {
+            return MODBUS_ASCII__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -711,7 +723,7 @@ static const modbus_ascii__element_t modbus_ascii__l_request_0_e[] = {
     {MODBUS_ASCII__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* lrc */
     {MODBUS_ASCII__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, modbus_ascii__l_request_0_c5},  /* end */
 };
-static const modbus_ascii__layout_t modbus_ascii__l_request_0 = {modbus_ascii__l_request_0_e, 6u, 3, 2, 2u, 1u, 4u, NULL, 0u, 1u, 0u, 0UL, 6u, 1u, 2u, -1, 0u, 0u};
+static const modbus_ascii__layout_t modbus_ascii__l_request_0 = {modbus_ascii__l_request_0_e, 6u, 3, 2, 2u, 1u, 4u, NULL, 0u, 1u, 0u, 0UL, 6u, 1u, 2u, -1, 0u, 0u, -1, 0UL};
 
 /* The response frame. */
 /* From the address to the LRC, every byte is sent as two hex digits (serial §2.5.2.1): `01 03` as `0103`. */
@@ -725,7 +737,7 @@ static const modbus_ascii__element_t modbus_ascii__l_response_0_e[] = {
     {MODBUS_ASCII__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* lrc */
     {MODBUS_ASCII__ROLE_CONSTANT, 2u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, modbus_ascii__l_response_0_c5},  /* end */
 };
-static const modbus_ascii__layout_t modbus_ascii__l_response_0 = {modbus_ascii__l_response_0_e, 6u, 3, 2, 2u, 1u, 4u, NULL, 0u, 1u, 0u, 128UL, 6u, 1u, 2u, -1, 0u, 0u};
+static const modbus_ascii__layout_t modbus_ascii__l_response_0 = {modbus_ascii__l_response_0_e, 6u, 3, 2, 2u, 1u, 4u, NULL, 0u, 1u, 0u, 128UL, 6u, 1u, 2u, -1, 0u, 0u, -1, 0UL};
 
 static const modbus_ascii__layout_t *const modbus_ascii__layouts_request[] = {&modbus_ascii__l_request_0};
 static const modbus_ascii__layout_t *const modbus_ascii__layouts_response[] = {&modbus_ascii__l_response_0};

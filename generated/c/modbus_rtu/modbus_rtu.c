@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } modbus_rtu__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -548,6 +550,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
     int bounded = 0;
     uint8_t k, first = modbus_rtu__inner_first(L);
     long code = MODBUS_RTU__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return MODBUS_RTU__WAIT;
     }
@@ -565,7 +568,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
             uint32_t value = modbus_rtu__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? MODBUS_RTU__ERROR_CODE : (long)value;
-            if (!modbus_rtu__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !modbus_rtu__bounds(dir, code, &low, &high, &bounded)) {
                 return MODBUS_RTU__NONE;
             }
         } else if (e->role == MODBUS_RTU__ROLE_VALUE) {
@@ -573,8 +576,17 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
             if (!(MODBUS_RTU__PLAUSIBLE(e, value))) {
                 return MODBUS_RTU__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != MODBUS_RTU__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? MODBUS_RTU__ERROR_CODE : code;
+        if (!modbus_rtu__bounds(dir, code, &low, &high, &bounded)) {
+            return MODBUS_RTU__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -648,7 +660,7 @@ static const modbus_rtu__element_t modbus_rtu__l_request_0_e[] = {
     {MODBUS_RTU__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {MODBUS_RTU__ROLE_CHECKSUM, 2u, 0u, 0u, 2u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const modbus_rtu__layout_t modbus_rtu__l_request_0 = {modbus_rtu__l_request_0_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 4u, 2u, 2u, -1, 0u, 0u};
+static const modbus_rtu__layout_t modbus_rtu__l_request_0 = {modbus_rtu__l_request_0_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 4u, 2u, 2u, -1, 0u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const modbus_rtu__element_t modbus_rtu__l_response_0_e[] = {
@@ -657,7 +669,7 @@ static const modbus_rtu__element_t modbus_rtu__l_response_0_e[] = {
     {MODBUS_RTU__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {MODBUS_RTU__ROLE_CHECKSUM, 2u, 0u, 0u, 2u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const modbus_rtu__layout_t modbus_rtu__l_response_0 = {modbus_rtu__l_response_0_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 128UL, 4u, 2u, 2u, -1, 0u, 0u};
+static const modbus_rtu__layout_t modbus_rtu__l_response_0 = {modbus_rtu__l_response_0_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 128UL, 4u, 2u, 2u, -1, 0u, 0u, -1, 0UL};
 
 static const modbus_rtu__layout_t *const modbus_rtu__layouts_request[] = {&modbus_rtu__l_request_0};
 static const modbus_rtu__layout_t *const modbus_rtu__layouts_response[] = {&modbus_rtu__l_response_0};

@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } roboclaw__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -567,6 +569,7 @@ static long roboclaw__probe(const roboclaw__layout_t *L, roboclaw_direction_t di
     int bounded = 0;
     uint8_t k, first = roboclaw__inner_first(L);
     long code = ROBOCLAW__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return ROBOCLAW__WAIT;
     }
@@ -584,7 +587,7 @@ static long roboclaw__probe(const roboclaw__layout_t *L, roboclaw_direction_t di
             uint32_t value = roboclaw__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? ROBOCLAW__ERROR_CODE : (long)value;
-            if (!roboclaw__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !roboclaw__bounds(dir, code, &low, &high, &bounded)) {
                 return ROBOCLAW__NONE;
             }
         } else if (e->role == ROBOCLAW__ROLE_VALUE) {
@@ -592,8 +595,17 @@ static long roboclaw__probe(const roboclaw__layout_t *L, roboclaw_direction_t di
             if (!(ROBOCLAW__PLAUSIBLE(e, value))) {
                 return ROBOCLAW__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != ROBOCLAW__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? ROBOCLAW__ERROR_CODE : code;
+        if (!roboclaw__bounds(dir, code, &low, &high, &bounded)) {
+            return ROBOCLAW__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -665,7 +677,7 @@ static const roboclaw__element_t roboclaw__l_request_0_e[] = {
     {ROBOCLAW__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 128UL, 135UL, 0UL, NULL},  /* address */
     {ROBOCLAW__ROLE_COMMAND, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 255UL, 0UL, NULL},  /* command */
 };
-static const roboclaw__layout_t roboclaw__l_request_0 = {roboclaw__l_request_0_e, 2u, -1, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 2u, 2u, 0u, -1, 0u, 0u};
+static const roboclaw__layout_t roboclaw__l_request_0 = {roboclaw__l_request_0_e, 2u, -1, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 2u, 2u, 0u, -1, 0u, 0u, -1, 0UL};
 
 /* The request frame write. */
 static const roboclaw__element_t roboclaw__l_request_1_e[] = {
@@ -674,21 +686,21 @@ static const roboclaw__element_t roboclaw__l_request_1_e[] = {
     {ROBOCLAW__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {ROBOCLAW__ROLE_CHECKSUM, 2u, 1u, 0u, 2u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const roboclaw__layout_t roboclaw__l_request_1 = {roboclaw__l_request_1_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 4u, 2u, 2u, -1, 0u, 0u};
+static const roboclaw__layout_t roboclaw__l_request_1 = {roboclaw__l_request_1_e, 4u, 2, 1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 4u, 2u, 2u, -1, 0u, 0u, -1, 0UL};
 
 /* The response frame read. */
 static const roboclaw__element_t roboclaw__l_response_0_e[] = {
     {ROBOCLAW__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {ROBOCLAW__ROLE_CHECKSUM, 2u, 1u, 0u, 0u, 0u, 1u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const roboclaw__layout_t roboclaw__l_response_0 = {roboclaw__l_response_0_e, 2u, 0, -1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 2u, 0u, 2u, -1, 0u, 0u};
+static const roboclaw__layout_t roboclaw__l_response_0 = {roboclaw__l_response_0_e, 2u, 0, -1, 0u, 0u, 0u, NULL, 0u, 0u, 0u, 0UL, 2u, 0u, 2u, -1, 0u, 0u, -1, 0UL};
 
 /* The response frame write. */
 static const uint8_t roboclaw__l_response_1_c0[] = {0xffu};
 static const roboclaw__element_t roboclaw__l_response_1_e[] = {
     {ROBOCLAW__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, roboclaw__l_response_1_c0},  /* ack */
 };
-static const roboclaw__layout_t roboclaw__l_response_1 = {roboclaw__l_response_1_e, 1u, -1, -1, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 1u, 1u, 0u, -1, 0u, 0u};
+static const roboclaw__layout_t roboclaw__l_response_1 = {roboclaw__l_response_1_e, 1u, -1, -1, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 1u, 1u, 0u, -1, 0u, 0u, -1, 0UL};
 
 static const roboclaw__layout_t *const roboclaw__layouts_request[] = {&roboclaw__l_request_0, &roboclaw__l_request_1};
 static const roboclaw__layout_t *const roboclaw__layouts_response[] = {&roboclaw__l_response_0, &roboclaw__l_response_1};

@@ -139,6 +139,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } ubx__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -546,6 +548,7 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
     int bounded = 0;
     uint8_t k, first = ubx__inner_first(L);
     long code = UBX__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return UBX__WAIT;
     }
@@ -563,7 +566,7 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
             uint32_t value = ubx__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? UBX__ERROR_CODE : (long)value;
-            if (!ubx__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !ubx__bounds(dir, code, &low, &high, &bounded)) {
                 return UBX__NONE;
             }
         } else if (e->role == UBX__ROLE_VALUE) {
@@ -571,8 +574,17 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
             if (!(UBX__PLAUSIBLE(e, value))) {
                 return UBX__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != UBX__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? UBX__ERROR_CODE : code;
+        if (!ubx__bounds(dir, code, &low, &high, &bounded)) {
+            return UBX__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -648,7 +660,7 @@ static const ubx__element_t ubx__l_request_0_e[] = {
     {UBX__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {UBX__ROLE_CHECKSUM, 2u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const ubx__layout_t ubx__l_request_0 = {ubx__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 0u, 0UL, 8u, 6u, 2u, 2, 4u, 0u};
+static const ubx__layout_t ubx__l_request_0 = {ubx__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 0u, 0UL, 8u, 6u, 2u, 2, 4u, 0u, -1, 0UL};
 
 /* The response frame. */
 static const uint8_t ubx__l_response_0_c0[] = {0xb5u, 0x62u};
@@ -659,7 +671,7 @@ static const ubx__element_t ubx__l_response_0_e[] = {
     {UBX__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* payload */
     {UBX__ROLE_CHECKSUM, 2u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const ubx__layout_t ubx__l_response_0 = {ubx__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 0u, 0UL, 8u, 6u, 2u, 2, 4u, 0u};
+static const ubx__layout_t ubx__l_response_0 = {ubx__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 0u, 0UL, 8u, 6u, 2u, 2, 4u, 0u, -1, 0UL};
 
 static const ubx__layout_t *const ubx__layouts_request[] = {&ubx__l_request_0};
 static const ubx__layout_t *const ubx__layouts_response[] = {&ubx__l_response_0};

@@ -141,6 +141,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } vesc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -548,6 +550,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
     int bounded = 0;
     uint8_t k, first = vesc__inner_first(L);
     long code = VESC__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return VESC__WAIT;
     }
@@ -565,7 +568,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
             uint32_t value = vesc__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? VESC__ERROR_CODE : (long)value;
-            if (!vesc__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !vesc__bounds(dir, code, &low, &high, &bounded)) {
                 return VESC__NONE;
             }
         } else if (e->role == VESC__ROLE_VALUE) {
@@ -573,8 +576,17 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
             if (!(VESC__PLAUSIBLE(e, value))) {
                 return VESC__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != VESC__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? VESC__ERROR_CODE : code;
+        if (!vesc__bounds(dir, code, &low, &high, &bounded)) {
+            return VESC__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {
@@ -652,7 +664,7 @@ static const vesc__element_t vesc__l_request_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u};
+static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u, -1, 0UL};
 
 /* The request frame long. */
 static const uint8_t vesc__l_request_1_c0[] = {0x03u};
@@ -665,7 +677,7 @@ static const vesc__element_t vesc__l_request_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u};
+static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u, -1, 0UL};
 
 /* The response frame short. */
 static const uint8_t vesc__l_response_0_c0[] = {0x02u};
@@ -678,7 +690,7 @@ static const vesc__element_t vesc__l_response_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u};
+static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u, -1, 0UL};
 
 /* The response frame long. */
 static const uint8_t vesc__l_response_1_c0[] = {0x03u};
@@ -691,7 +703,7 @@ static const vesc__element_t vesc__l_response_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u};
+static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u, -1, 0UL};
 
 static const vesc__layout_t *const vesc__layouts_request[] = {&vesc__l_request_0, &vesc__l_request_1};
 static const vesc__layout_t *const vesc__layouts_response[] = {&vesc__l_response_0, &vesc__l_response_1};

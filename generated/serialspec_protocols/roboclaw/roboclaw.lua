@@ -1924,9 +1924,11 @@ end
 
 -- --- frames ----------------------------------------------------------------------------------------------------------
 
-local function entry_of(direction, code, layout)
+local function entry_of(direction, code, layout, status)
   if layout.error then return direction.codes.error end -- an error header's layout: the error reply
   if code == nil then return direction.codes.none end
+  -- the status's error bits set (`error_bits`): the error reply, refusing the request of this code
+  if status and direction.error_bits and band(status, direction.error_bits) ~= 0 then return direction.codes.error end
   if layout.codes and not layout.codes[code] then return nil end -- layouts chosen by command: sent in another
   if direction.error_flag and band(code, direction.error_flag) ~= 0 then return direction.codes.error end
   return direction.codes[code]
@@ -1984,7 +1986,7 @@ local function frame_size(direction, layout, data, pos, request)
   local available = #data - pos + 1
   local answer = direction.answers and request and direction.answers[request.message.answer]
   if answer and answer.layout ~= layout.name then return nil end
-  local entry
+  local entry, seen, status
   for index = 1, layout.first - 1 do
     local element, offset = layout.elements[index], layout.before[index]
     if available < offset + element.size then return false end
@@ -1995,11 +1997,20 @@ local function frame_size(direction, layout, data, pos, request)
       local code = unsigned(bytes, element.big)
       if element.wire then code = element.wire[code] end -- sent as an expression of the code (`code:`)
       if code == nil then return nil end
-      entry = entry_of(direction, code, layout)
-      if entry == nil then return nil end
+      seen = code
+      if not direction.error_status then
+        entry = entry_of(direction, code, layout)
+        if entry == nil then return nil end
+      end
     elseif element.role == "address" or element.role == "status" or element.role == "value" then
-      if not plausible(element, unsigned(bytes, element.big)) then return nil end
+      local value = unsigned(bytes, element.big)
+      if not plausible(element, value) then return nil end
+      if element.name == direction.error_status then status = value end
     end
+  end
+  if direction.error_status and seen ~= nil then -- the error reply where the status says so (`error_bits`)
+    entry = entry_of(direction, seen, layout, status)
+    if entry == nil then return nil end
   end
   local has_command = false
   for _, element in ipairs(layout.elements) do
@@ -2178,8 +2189,9 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     offset = offset + length
   end
   -- the command and the message (the command may lie in the stuffed part: read here, after unstuffing)
-  local code, content_index = nil, nil
+  local code, content_index, status = nil, nil, nil
   for index, element in ipairs(elements) do
+    if element.name == direction.error_status then status = unsigned(plain[index], element.big) end
     if element.role == "command" then
       code = unsigned(plain[index], element.big)
       if element.wire and element.wire[code] == nil then
@@ -2189,7 +2201,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     end
     if element.role == "content" then content_index = index end
   end
-  entry = entry or entry_of(direction, code, layout)
+  entry = entry or entry_of(direction, code, layout, status)
   if entry == nil then error(string.format("no command %s in this direction", tostring(code)), 0) end
   local message = entry.message
   if entry.subs then

@@ -647,7 +647,8 @@ MESSAGE = Obj(
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
             "under the request's code plus the command element's `error_flag` (Modbus exception replies), or "
-            "under the header's `error_value` (MSP's `$M!`). Its message carries the code of the refused request "
+            "under the header's `error_value` (MSP's `$M!`), or with the status element's `error_bits` set (SHDLC's "
+            "state byte). Its message carries the code of the refused request "
             "in a value named after the command element; clients raise DeviceError for it."
         ),
         "optional_when": OPTIONAL_WHEN,
@@ -1079,6 +1080,14 @@ FRAME_ELEMENT = Obj(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
         ),
+        "error_bits": Int(
+            "status: bits whose being set in a reply's status make it an error reply (SHDLC: 0x7F, the execution "
+            "error code of the state byte); such a reply carries the refused request's code in the command element, "
+            "its status as it is, and its content is that of the command whose response is the `error_reply`; a "
+            "reply whose status has none of them is the command's own. Encode refuses an error reply without one "
+            "of them set and any other reply with one; clients raise DeviceError naming the status.",
+            example=0x7F,
+        ),
         "error_value": Str(
             "header: the bytes a response starts with instead of its `value` when it refuses the request (MSP: "
             "`24 4d 21`, `$M!` where replies carry `$M>`); such a reply has the response's layout, its command "
@@ -1186,6 +1195,26 @@ FRAME_ELEMENT = Obj(
     },
     required=("role",),
     description="One element of the frame, in wire order.",
+    variants=(
+        (
+            "Error replies told by their status (SHDLC's state byte: an execution error code in bits 6..0, the "
+            "device's error flag in bit 7)",
+            {
+                "state": {
+                    "role": "status",
+                    "type": "u8",
+                    "directions": ["response"],
+                    "error_bits": 0x7F,
+                    "bits": {"error": {"bits": 7}, "code": {"bits": [6, 0], "enum": "execution_error"}},
+                }
+            },
+            "With a command `refused: {response: {error_reply: true, fields: {}}}` (no `code`), `7E 00 D1 43 00 EB "
+            "7E` decodes as `refused` with `command` = 0xD1 (the refused request, Read Version) and `state.code` = "
+            "0x43, its length 0 where Read Version's reply carries 7 bytes; `state` = 0x80 (bit 7 alone) is a normal "
+            "reply. The status must come before the content and the frame needs a command element; one of "
+            "`error_flag`, `error_value` and `error_bits` per protocol.",
+        ),
+    ),
 )
 
 FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")

@@ -675,7 +675,8 @@ def _by_trailing_code(trailing: _TrailingCodes, buffer: bytes, start: int, end: 
 
 class FrameCodec:
     """One direction's frames: its layouts (alternatives, tried in order on encode), the content decoders' codes;
-    `error_flag`: codes with these bits set are error replies (their sizes under ERROR_REPLY)."""
+    `error_flag`: codes with these bits set are error replies (their sizes under ERROR_REPLY); `error_status`: the
+    status element, and its bits, whose being set makes a frame an error reply (the code that of the request)."""
 
     def __init__(
         self,
@@ -685,6 +686,7 @@ class FrameCodec:
         error_flag: int = 0,
         replies: dict[Any, int] | None = None,
         refusals: dict[str, tuple[str, ...]] | None = None,
+        error_status: tuple[str, int] | None = None,
     ) -> None:
         """`replies`: frames that carry no code, in layouts chosen by command: each reply class's layout (by index),
         read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
@@ -703,6 +705,7 @@ class FrameCodec:
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
+        self.error_status = error_status
         self._trailing_cache: dict[int, _TrailingCodes | None] = {}  # by id() of a layout of self.variants
         # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
         self.sizers = tuple(self._sizer(layout) for layout in self.variants)
@@ -820,6 +823,7 @@ class FrameCodec:
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
         code: int | None = None
+        refused = False  # the status's error bits set (`error_status`)
         for element, first, stop in plan["probe_head"]:  # the fixed part before anything variable
             if available < stop:
                 return None
@@ -837,8 +841,19 @@ class FrameCodec:
                     value = from_wire[value]
                 code = ERROR_REPLY if layout.error or value & self.error_flag else value
                 if code not in self.content_sizes or (layout.codes is not None and code not in layout.codes):
+                    if self.error_status is None:
+                        return -1
+                    code = -2  # none: unless the status says this is an error reply (any code's)
+            elif kind == "value":
+                value = int.from_bytes(data, element.endian)
+                if not element.plausible(value):
                     return -1
-            elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
+                if self.error_status is not None and element.name == self.error_status[0]:
+                    refused = bool(value & self.error_status[1])
+        if self.error_status is not None and code is not None:
+            if refused:
+                code = ERROR_REPLY
+            elif code == -2:
                 return -1
         if layout.command is None:
             code = reading  # type: ignore[assignment]  # (replies' content sizes are by class name)
@@ -962,7 +977,8 @@ class FrameCodec:
             allowed: list[list[int]] = [list(range(256))] * (stop - first)
             if element.kind == "constant":
                 allowed = [[byte] for byte in element.constant]
-            elif element.kind == "command" and stop == first + 1:
+            elif element.kind == "command" and stop == first + 1 and self.error_status is None:
+                # (error replies told by their status may carry any code: every byte)
                 codes = self.content_sizes
                 from_wire: dict[int, int] = layout.from_wire  # type: ignore[attr-defined]
                 allowed = [
@@ -1014,6 +1030,8 @@ class FrameCodec:
         )
         content_sizes, size_rules, error_flag = self.content_sizes, self.size_rules, self.error_flag
         refusing = layout.error
+        if self.error_status is not None:  # error replies told by their status: probe() decides
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         codeless = layout.command is None
         if codeless and None not in content_sizes:
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)

@@ -100,8 +100,13 @@ class ErrorReplies:
         if not self.reason_field:  # an error reply that says no more than that (MSP's `$M!`)
             return f"{request.COMMAND}: the device refuses it"
         reason: Any = getattr(reply, self.reason_field)
-        name = f"{reason.name.lower()} ({reason.value})" if isinstance(reason, Enum) else str(reason)
-        return f"{request.COMMAND}: the device refuses it: {self.reason_field} = {name}"
+        if isinstance(reason, Record):  # a status of bit fields (`error_bits`): each that is not zero
+            said = [(f"{self.reason_field}.{k}", getattr(reason, k)) for k in reason.__match_args__]
+            said = [(k, v) for k, v in said if v] or said
+        else:
+            said = [(self.reason_field, reason)]
+        text = ", ".join(f"{k} = {f'{v.name.lower()} ({v.value})' if isinstance(v, Enum) else v}" for k, v in said)
+        return f"{request.COMMAND}: the device refuses it: {text}"
 
 
 @dataclass(frozen=True)

@@ -78,6 +78,8 @@ typedef struct {
     int8_t length;       /* index of the length element (before the variable part), -1 without */
     uint16_t length_off; /* its offset */
     uint16_t counted;    /* the fixed sizes of the elements it counts */
+    int8_t error_status; /* index of the status whose error_bits set make a frame an error reply, -1 without */
+    uint32_t error_bits;
 } pfx__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -468,6 +470,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
     int bounded = 0;
     uint8_t k, first = pfx__inner_first(L);
     long code = PFX__NO_CODE;
+    int refused = 0; /* the status's error bits set (`error_bits`): an error reply, whatever its code */
     if (avail < L->prefix) {
         return PFX__WAIT;
     }
@@ -485,7 +488,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             uint32_t value = pfx__get(b + pos, e->size, e->big);
             /* (error_flag 0xFFFFFFFF: an error header's layout, every frame of it an error reply) */
             code = (L->error_flag == 0xFFFFFFFFu || (value & L->error_flag) != 0u) ? PFX__ERROR_CODE : (long)value;
-            if (!pfx__bounds(dir, code, &low, &high, &bounded)) {
+            if (L->error_status < 0 && !pfx__bounds(dir, code, &low, &high, &bounded)) {
                 return PFX__NONE;
             }
         } else if (e->role == PFX__ROLE_VALUE) {
@@ -493,8 +496,17 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             if (!(PFX__PLAUSIBLE(e, value))) {
                 return PFX__NONE;
             }
+            if ((int)k == (int)L->error_status && (value & L->error_bits) != 0u) {
+                refused = 1;
+            }
         }
         pos = stop;
+    }
+    if (L->error_status >= 0 && code != PFX__NO_CODE) { /* told by the status: its bounds, or the code's */
+        code = refused ? PFX__ERROR_CODE : code;
+        if (!pfx__bounds(dir, code, &low, &high, &bounded)) {
+            return PFX__NONE;
+        }
     }
     before = pos;
     if (L->command < 0) {

@@ -439,10 +439,13 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         a, b = names.index(layout.elements[length].counts[0]), names.index(layout.elements[length].counts[1])
         counted = sum(sizes[a : b + 1])
     prefix = _prefix(ctx, layout)
+    status, bits = -1, 0
+    if error is not None and error.status and direction == Direction.RESPONSE:  # told by the status (`error_bits`)
+        status, bits = names.index(error.status), error.bits
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
         f"{method}u, {tf}u, {tl}u, {pairs}, {pair_count}u, {header_len}u, {prefix}u, "
-        f"{error_flag}UL, {overhead}u, {before}u, {after}u, {length}, {length_off}u, {counted}u}};"
+        f"{error_flag}UL, {overhead}u, {before}u, {after}u, {length}, {length_off}u, {counted}u, {status}, {bits}UL}};"
     )
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
@@ -604,6 +607,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
     wanted = asking.by_reply(ctx.protocol, direction)  # no code: sized as the reply awaited (`want`, its kind)
     asked = asking.asked_replies(ctx.protocol)  # (a reply sized by its request: `asked`, the request's field)
+    status_told = error is not None and bool(error.status) and direction == Direction.RESPONSE and command >= 0
     lines = [
         f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: probe, straight line. */",
         f"static long {p}__probe_{direction.value}_{k}(const uint8_t *f, size_t avail"
@@ -613,6 +617,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
         "    int bounded = 0;",
         f"    long code = {P}__NO_CODE;",
         "    (void)code;",
+        *(["    uint32_t status = 0u;"] if status_told else []),
     ]
     waited = prefix
     if prefix:
@@ -637,16 +642,24 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
                 lines.append(f"    if (code < 0L) {{ return {P}__NONE; }}")
             else:
                 lines.append(f"    code = {code}; /* {e.name} */")
-            lines.append(
-                f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
-            )
+            if not status_told:  # (told by the status: bounds once it is read)
+                lines.append(
+                    f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
+                )
             if layout_codes(ctx.protocol, layout) is not None:  # layouts chosen by command: a code sent in it
                 lines.append(f"    if (!{p}__sends({P}_{direction.name}, {k}u, code)) {{ return {P}__NONE; }}")
         elif e.role in VALUE_ROLES:
             test = _range_test(e, "v", sizes[i], _need(ctx, direction, k, e))
             if test is not None:
                 lines.append(f"    {{ uint32_t v = {value}; if ({test}) {{ return {P}__NONE; }} }} /* {e.name} */")
+            if status_told and error is not None and e.name == error.status:  # its error bits: the error reply
+                lines.append(f"    status = {value};")
         offset = stop
+    if status_told and error is not None:
+        lines += [
+            f"    if ((status & {error.bits}UL) != 0u) {{ code = {P}__ERROR_CODE; }} /* `error_bits`: any code's */",
+            f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}",
+        ]
     if command < 0 and wanted:  # only the replies of this layout, the one awaited
         kinds = [
             kind_name(ctx, m)
@@ -1124,8 +1137,20 @@ def source(ctx: Ctx) -> str:
             key = code_key(P, code)
             command = protocol.command(users[0].command)
             body = []
-            if code == ERROR_CODE and protocol.error_reply is not None and not protocol.error_reply.flag:
+            if code == ERROR_CODE and protocol.error_reply is not None and protocol.error_reply.by_header:
                 continue  # told by its header (`error_value`): decode_expect decodes it ({p}__decode_refused)
+            if code == ERROR_CODE and protocol.error_reply is not None and protocol.error_reply.status:
+                error = protocol.error_reply
+                element = error_element(protocol, users[0])
+                assert element is not None
+                at = next(i for i, (name, _) in enumerate(values) if name == error.status)
+                error_first = [  # told by the status (`error_bits`): the refused request's code as it is
+                    f"        if (code >= 0 && ((unsigned long)values[{at}] & {error.bits}UL) != 0u) {{",
+                    f"            out->u.{msg_id(users[0])}.{ident(error.element)} = ({_ctype_of(element[1])})code;",
+                    f"            {dec_call(ctx, users[0], values)}",
+                    "        }",
+                ]
+                continue
             if code == ERROR_CODE and protocol.error_reply is not None:
                 error = protocol.error_reply
                 element = error_element(protocol, users[0])
@@ -1215,7 +1240,7 @@ def source(ctx: Ctx) -> str:
         vsets = []
         element = error_element(protocol, m)
         if element is not None and protocol.error_reply is not None and not protocol.error_reply.flag:
-            wire_code = f"(uint32_t)m->{ident(element[0])}"  # under the error header (`error_value`)
+            wire_code = f"(uint32_t)m->{ident(element[0])}"  # under the error header or with the status's error bits
         elif element is not None and protocol.error_reply is not None:
             flag = protocol.error_reply.flag
             vchecks.append(f"    if ((m->{ident(element[0])} & {flag}u) != 0u) {{ return {P}_E_RANGE; }}")
@@ -1232,6 +1257,11 @@ def source(ctx: Ctx) -> str:
                 if e.broadcast is not None:
                     cond = f"({cond}) && m->{ident(name)} != {e.broadcast}u"
                 vchecks.append(f"    if ({cond}) {{ return {P}_E_RANGE; }} /* {name} */")
+            told = protocol.error_reply
+            if told is not None and told.status == name and m.direction == Direction.RESPONSE:
+                # told by the status (`error_bits`): the error reply has one set, every other reply none
+                has = f"(m->{ident(name)} & {told.bits}u) != 0u"
+                vchecks.append(f"    if ({'!' if m.error_reply else ''}({has})) {{ return {P}_E_RANGE; }} /* {name} */")
             mask, bits = fixed_bits(e.bits)
             if mask:  # constant bit fields: a value without them is refused, as Python's encode does
                 vchecks.append(

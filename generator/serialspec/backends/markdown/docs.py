@@ -341,6 +341,11 @@ def error_reply_text(protocol: Protocol, message: Message) -> str:
     error = protocol.error_reply
     if not message.error_reply or error is None:
         return ""
+    if error.status:
+        return (
+            f"sent instead of any request's reply, with one of the bits {error.bits:#04x} set in `{error.status}` and "
+            f"`{error.element}` = the request's code (the message holds it as `{error.element}`)"
+        )
     if not error.flag:
         return (
             f"sent instead of any request's reply, under the header {error.header.hex(' ')} with `{error.element}` = "

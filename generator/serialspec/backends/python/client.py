@@ -628,6 +628,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         assert reply is not None
         module_imports.add(reply.class_name)
         reason = next((f.name for f in reply.fields if not (isinstance(f, Scalar) and f.hidden)), "")
+        reason = protocol.error_reply.status or reason  # told by its status (`error_bits`): the status says why
         codes = {c.name: c.code for c in protocol.commands if c.code is not None and c.request is not None}
         errors = {
             "response": reply.class_name,

@@ -898,6 +898,13 @@ class PackageCode:
                 continue
             self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
             frame_values.append(Simple(field_read("m", f.name)))
+        self.check_error_bits(
+            message,
+            [f.name for f in frame_fields if f.name != getattr(error, "element", None)],
+            frame_values,
+            body,
+            where,
+        )
         self.check_count_from(message, body, where)
         return message_frame(self, message, frame_values, body, where)  # the frame around the content: frames/encode.py
 
@@ -920,6 +927,25 @@ class PackageCode:
             f"out_of_range({where}, {spec_key(f.name)}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
         )
         body.append(If(condition, (Raise(error),)))
+
+    def check_error_bits(
+        self, message: Message, names: list[str], frame_values: list[str], body: Block, where: str
+    ) -> None:
+        """Where the status's `error_bits` mark the error reply: the error reply has one of them set, every other
+        reply none (it would be read back as the error reply)."""
+        error = self.protocol.error_reply
+        if error is None or not error.status or message.direction != Direction.RESPONSE:
+            return
+        value = frame_values[names.index(error.status)]
+        if message.error_reply:
+            condition = f"not ({value}) & {error.bits:#04x}"
+            reason = f"an error reply has one of the error bits {error.bits:#04x} set in {error.status}"
+        else:
+            condition = f"({value}) & {error.bits:#04x}"
+            reason = (
+                f"{error.status} has error bits {error.bits:#04x} set: only the error reply ({error.command}) has them"
+            )
+        body.append(If(condition, (Raise(f"EncodeError({where} + {': ' + reason!r})"),)))
 
     def check_count_from(self, message: Message, body: Block, where: str) -> None:
         """A response list whose count the request gives (`count_from`) holds no more items than the request's

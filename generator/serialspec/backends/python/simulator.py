@@ -362,7 +362,16 @@ def simulator_module(protocol: Protocol) -> str:
         imports.add(reply.class_name)
         unwraps = device.errors.unsupported is not None
         unwrap = ", unwrap=_unwrap_request" if unwraps else ""
-        error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap})"
+        status = ""
+        if protocol.error_reply.status:  # told by its status (`error_bits`): its bit fields, each set by a reason
+            element = next(
+                e
+                for e in protocol.framing.layouts[Direction.RESPONSE].elements
+                if e.name == protocol.error_reply.status
+            )
+            bits = tuple((b.name, b.low, b.high) for b in element.bits)
+            status = f", status=({element.name!r}, {bits!r})"
+        error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap}{status})"
     runtime = ["CommandSpec", "DeviceSpec"]
     runtime += ["EntrySpec"] if entries else []
     runtime += ["ErrorSpec"] if error else []

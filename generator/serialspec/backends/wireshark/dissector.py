@@ -201,6 +201,9 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
     if protocol.error_reply is not None:
         result["error_flag"] = protocol.error_reply.flag
         result["error_element"] = protocol.error_reply.element
+        if protocol.error_reply.status:  # told by the status's `error_bits`
+            result["error_status"] = protocol.error_reply.status
+            result["error_bits"] = protocol.error_reply.bits
     return result
 
 

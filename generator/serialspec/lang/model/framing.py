@@ -179,13 +179,21 @@ class Framing:
 class ErrorReply:
     """Replies that refuse a request: its code with `flag` set in the command element (Modbus exception replies:
     function | 0x80, then an exception code), or its code under another header (`header`, the header element's
-    `error_value`: MSP's `$M!`, in the response layout named `layout`), laid out as `command`'s response."""
+    `error_value`: MSP's `$M!`, in the response layout named `layout`), or its code with any of `bits` set in the
+    status element named `status` (`error_bits`: SHDLC's state byte), laid out as `command`'s response."""
 
-    flag: int  # 0: told by the header
+    flag: int  # 0: told by the header or the status
     element: str  # the command element; the error reply's message carries the refused code under this name
     command: str  # the command whose response is the error reply
     header: bytes = b""
     layout: str = ""
+    status: str = ""  # the status element whose `bits` mark an error reply ("": none)
+    bits: int = 0
+
+    @property
+    def by_header(self) -> bool:
+        """Told by the header (`error_value`): every frame of its layout is an error reply."""
+        return bool(self.layout)
 
 
 @frozen

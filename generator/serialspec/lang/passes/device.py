@@ -670,9 +670,12 @@ class DevicePass(Pass):
             return None
         reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
         reasons = {}
+        carried = {f.name for f in reply.fields} if reply is not None else set()
+        if self.ctx.error_reply is not None and self.ctx.error_reply.status:  # told by its status: it says why
+            carried.add(self.ctx.error_reply.status)
         for reason, values in value.items():
             for key in values:
-                if reply is not None and key.partition(".")[0] not in {f.name for f in reply.fields}:
+                if reply is not None and key.partition(".")[0] not in carried:
                     self.error((*path, reason, key), f"the error reply {reply.command} has no field {key!r}")
             reasons[str(reason)] = {str(k): float(v) for k, v in values.items()}
         if "unsupported" in reasons:

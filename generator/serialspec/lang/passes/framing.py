@@ -460,7 +460,7 @@ class FramingPass(FieldResolver):
                 (*elements_path, names[content_index], "truncate"),
                 "a truncated content needs a length element: the frame must say how much of it was sent",
             )
-        flagged = any("error_flag" in item for item in raws.values())
+        flagged = any("error_flag" in item or "error_bits" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
 
     def optional(

@@ -66,6 +66,9 @@ class ErrorSpec:
     # unwrap(frame) -> (code, frame values) of a whole request frame whose checksum verifies (the frame engine's),
     # for requests the codec cannot decode because their code is unknown
     unwrap: Callable[[bytes], tuple[int | None, tuple[int, ...]]] | None = None
+    # told by its status (`error_bits`): the status element's name and its bit fields (name, lowest, highest bit),
+    # all 0 but those the reason gives
+    status: tuple[str, tuple[tuple[str, int, int], ...]] | None = None
 
 
 @dataclass(frozen=True)
@@ -842,7 +845,11 @@ class Engine(FaultInjection):
         error = self.spec.error
         if error is None or reason not in self.spec.errors:
             return None
-        values: dict[str, Any] = {error.code_field: command.code or 0, **self.spec.errors[reason]}
+        values: dict[str, Any] = {error.code_field: command.code or 0}
+        if error.status is not None:  # the status says why: its bit fields 0 but those the reason gives
+            name, bits = error.status
+            values[name] = unpacked(bits, 0) if bits else 0
+        nest(values, self.spec.errors[reason])
         if self.spec.address:
             values[self.spec.address] = device.id
         return self._encode_reply(error.response, values)

@@ -152,11 +152,20 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None
             mask = (1 << (8 * element.type.size)) - 1
-            flag = protocol.error_reply.flag
-            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag, refusing=not flag)
-        plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
+            error = protocol.error_reply
+            flag = error.flag
+            frames = replace(
+                frames,
+                error_flag=flag,
+                error_keep=mask & ~flag,
+                refusing=error.by_header,
+                error_status=error.status,
+                error_bits=error.bits,
+            )
+        told = frames.error_flag or frames.error_bits
+        plain = unpacked_messages(single, code) if not expected and not told else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
-        names |= {ERROR_REPLY} if frames.error_flag or frames.refusing else set()
+        names |= {ERROR_REPLY} if frames.error_flag or frames.refusing or frames.error_bits else set()
         if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
             answering = [m for m in protocol.messages() if m.direction == direction]
             sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]

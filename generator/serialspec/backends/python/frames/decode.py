@@ -161,7 +161,7 @@ def decode_lines(
     if layout.error and command is not None:  # an error header: the error reply, refusing the request of `code`
         body.append(f"return _{target.upper}_DECODERS[ERROR_REPLY]({arguments}, code)")
     else:
-        body += dispatch_lines(target, code, arguments, nullable=False)
+        body += dispatch_lines(target, code, arguments, nullable=False, status=f"v_{target.error_status}")
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
@@ -200,9 +200,10 @@ def crc_residue(element: Element) -> int | None:
     return residue
 
 
-def dispatch_lines(target: Target, code: str, arguments: str, nullable: bool) -> Lines:
+def dispatch_lines(target: Target, code: str, arguments: str, nullable: bool, status: str = "") -> Lines:
     """Lines that decode the content with the decoder of `code` (an expression; "None" where frames carry none):
-    an error reply's where the error flag is set, the expected reply's where replies share a code."""
+    an error reply's where the error flag is set (or the status, an expression, has `error_bits` set), the expected
+    reply's where replies share a code."""
     table = f"_{target.upper}_DECODERS"
     if code == "None" and target.only and not target.expected:
         return [f"return {target.only}({arguments})"]
@@ -212,6 +213,11 @@ def dispatch_lines(target: Target, code: str, arguments: str, nullable: bool) ->
         lines += [
             f"if {known}{code} & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
             f"    return {table}[ERROR_REPLY]({arguments}, {code} & {target.error_keep:#04x})",
+        ]
+    if target.error_bits and code != "None":
+        lines += [
+            f"if {status} & {target.error_bits:#04x}:  # an error reply: it refuses the request of this code",
+            f"    return {table}[ERROR_REPLY]({arguments}, {code})",
         ]
     unknown = (
         f'f"unknown command {{{code}:#04x}}"'
@@ -340,7 +346,9 @@ def _engine_decode(decode: Lines, target: Target) -> Lines:
             "    if unwrapped.reply:  # a reply that refuses the request (`refused_by`), in its own layout",
             f"        expect = _{target.upper}_REFUSALS[unwrapped.reply]",
         ]
-    return [*decode, *refusing, *(f"    {line}" for line in dispatch_lines(target, "code", arguments, nullable=True))]
+    status = f"unwrapped.values[{target.value_names.index(target.error_status)}]" if target.error_status else ""
+    dispatched = dispatch_lines(target, "code", arguments, nullable=True, status=status)
+    return [*decode, *refusing, *(f"    {line}" for line in dispatched)]
 
 
 def choice_lines(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = None) -> Lines:

@@ -446,7 +446,7 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
         if error is not None:
             code = field_read("m", error.element) + (f" | {error.flag:#04x}" if error.flag else "")
         frames = package.straight(message.direction)
-        refusing = error is not None and not error.flag  # under the error header: its layouts alone
+        refusing = error is not None and error.by_header  # under the error header: its layouts alone
         if frames:
             kept = [
                 i

@@ -48,6 +48,8 @@ class Target:
     value_names: tuple[str, ...]  # the frame values every message of the direction carries, in element order
     error_flag: int = 0
     error_keep: int = 0
+    error_status: str = ""  # the status element whose `error_bits` set make a reply the error reply
+    error_bits: int = 0
     expected: bool = False
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
     requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)

@@ -59,9 +59,9 @@ commands:
     response: {fields: {lamp_id: u8, level: u16}}
 examples:
   ping_request:
-    source: made up (words 0101 ^ 0001 = 0100, little-endian on the wire)
+    source: made up (little-endian words, as the checksum is, 0x0101 ^ 0x0100 = 0x0001, sent 01 00)
     direction: request
-    printed: "b5 62 01 01 00 01 00 01"
+    printed: "b5 62 01 01 00 01 01 00"
     command: ping
     fields: {lamp_id: 1}
 """
@@ -114,15 +114,15 @@ def test_xor_in_a_classic_frame(tmp_path: Path, name: str, text: str, frame: str
 
 def test_xor_of_words_in_a_general_frame(tmp_path: Path) -> None:
     package, structs, docs = generated(tmp_path, "xor_words", GENERAL)
-    data = bytes.fromhex("b5 62 01 01 00 01 00 01")
+    data = bytes.fromhex("b5 62 01 01 00 01 01 00")
     message = package.decode(data, "request")
     assert message.lamp_id == 1 and package.encode(message) == data
-    with pytest.raises(ChecksumError):
-        package.decode(data[:-2] + b"\x01\x00", "request")
+    with pytest.raises(ChecksumError):  # the words read big-endian (what it did before its byte order counted)
+        package.decode(data[:-2] + b"\x00\x01", "request")
     reply = package.PingResponse(lamp_id=7, level=0x1234)
     wire = package.encode(reply)
     parser = package.StreamParser("response")
     assert parser.feed(wire[:5]) == [] and parser.feed(wire[5:]) == [reply]
     assert structs.REQUEST_FRAME.parse(data).content == b"\x01"
-    assert "XOR of the covered bytes taken as big-endian 16-bit words" in docs
-    assert "0x0101 ^ 0x0001 = 0x0100" in docs
+    assert "XOR of the covered bytes taken as little-endian 16-bit words" in docs
+    assert "0x0101 ^ 0x0100 = 0x0001" in docs

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import Phase, find, settings
 from hypothesis import strategies as st
 from serialspec.lang import load_protocol
-from serialspec.lang.model import Direction, Example, FrameElement, FrameLayout, Message, Protocol
+from serialspec.lang.model import Bytes, Direction, Example, FrameElement, FrameLayout, Message, Protocol
 from strategies import message_fields
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
@@ -118,6 +118,15 @@ def requests(g: Generated, spec: Message) -> st.SearchStrategy[Any]:
     request = request_spec(g, spec)
     cls = message_class(g, request)
     return message_fields(g.protocol, request).map(lambda fields: cls.from_fields(fields))
+
+
+def fitted(message: Message, fields: dict[str, Any], request: Any) -> dict[str, Any]:
+    """A reply's fields with its last bytes as many as its request asks for, where a field of the request says how
+    many (`size_from`: the encoder refuses another number where nothing else in the frame sizes them)."""
+    last = message.fields[-1] if message.fields else None
+    if request is None or not isinstance(last, Bytes) or not last.size_from:
+        return fields
+    return {**fields, last.name: " ".join(["5a"] * request.to_fields()[last.size_from])}
 
 
 def a_request(g: Generated, spec: Message) -> Any:

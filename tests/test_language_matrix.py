@@ -28,7 +28,7 @@ from typing import Any
 
 import pytest
 import yaml
-from conftest import Generated, examples
+from conftest import Generated, examples, fitted
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec import cli
@@ -38,7 +38,6 @@ from serialspec.encodings import bit_run
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
 from serialspec.lang.model import (
-    Bytes,
     Direction,
     Message,
     Protocol,
@@ -1517,15 +1516,6 @@ def asked(g: Generated, message: Message) -> Any:
         if m.direction.value == "request" and reply_to(m, replies_by_request(g.protocol.messages())) == message
     )
     return message_class(g, request).from_fields(st_examples(message_fields(g.protocol, request), 1)[0])
-
-
-def fitted(message: Message, fields: dict[str, Any], request: Any) -> dict[str, Any]:
-    """A reply's fields with its last bytes as many as its request asks for, where a field of the request says how
-    many (`size_from`: the encoder refuses another number where nothing else in the frame sizes them)."""
-    last = message.fields[-1] if message.fields else None
-    if request is None or not isinstance(last, Bytes) or not last.size_from:
-        return fields
-    return {**fields, last.name: " ".join(["5a"] * request.to_fields()[last.size_from])}
 
 
 def codec_and_structs(g: Generated, message: Message) -> None:

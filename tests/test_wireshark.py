@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated, examples, requests
+from conftest import ALL, ROOT, Generated, examples, fitted, requests
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from serialspec import cli
@@ -370,7 +370,7 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
                 asked = g.package.encode(request)
                 wanted.append(describe(protocol, g.package.decode(asked, "request"), asked, False, None))
                 lines.append(f"2026-11-25T10:00:00.000000+00:00 request {asked.hex(' ')}")
-            message = cls.from_fields(data.draw(message_fields(protocol, spec), label=spec.key))
+            message = cls.from_fields(fitted(spec, data.draw(message_fields(protocol, spec), label=spec.key), request))
             frame = g.package.encode(message) if request is None else g.package.encode(message, request)
             if request is None:
                 message = g.package.decode(frame, spec.direction.value)  # as a frame without its request decodes
@@ -425,6 +425,7 @@ def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False, twic
                     cls = next(c for c in package.MESSAGE_TYPES if c.__name__ == spec.class_name)
                     fields = data.draw(message_fields(protocol, spec), label=f"{protocol.title} {spec.key}")
                     request = data.draw(requests(g, spec), label=f"{protocol.title} {spec.key} answers")
+                    fields = fitted(spec, fields, request)
                     if request is not None:  # a reply read with its request: the request before it in the capture
                         asked = package.encode(request)
                         wanted.append(

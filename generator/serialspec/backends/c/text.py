@@ -24,6 +24,7 @@ from serialspec.backends.c.text_runtime import (
     used,
     written,
 )
+from serialspec.backends.common.text_frames import refuse_text_frames
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
@@ -32,26 +33,7 @@ RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "
 
 def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
-    if not text.start:
-        raise Unsupported("text frames without a start character (every line a frame)")
-    if any(c > "\x7f" for c in text.end):
-        raise Unsupported("a line ending with bytes above 0x7F (`end`)")
-    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
-        raise Unsupported("a text field to the end of the line (`size: rest`)")
-    if any(m.layout is not None for m in text.messages):
-        raise Unsupported("a message's own text layout (`text:`)")
-    if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
-        raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
-    if text.checksum is not None and text.checksum_format == "decimal":
-        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
-    if text.checksum is not None and text.checksum_directions != ("request", "response"):
-        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
-    if text.checksum is not None and text.checksum_separated:
-        raise Unsupported("a separator before the text checksum (`checksum.separated`)")
-    if text.response_start:
-        raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
-    if text.address is not None:
-        raise Unsupported("an address before the text code (`framing.address`)")
+    refuse_text_frames(text)
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")

@@ -8,6 +8,7 @@ from typing import Any
 
 from serialspec.backends import Unsupported
 from serialspec.backends.common.render import render
+from serialspec.backends.common.text_frames import refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
 
@@ -17,26 +18,7 @@ def _field(f: TextField) -> dict[str, Any]:
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
-    if not text.start:
-        raise Unsupported("text frames without a start character (every line a frame)")
-    if any(c > "\x7f" for c in text.end):
-        raise Unsupported("a line ending with bytes above 0x7F (`end`)")
-    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
-        raise Unsupported("a text field to the end of the line (`size: rest`)")
-    if any(m.layout is not None for m in text.messages):
-        raise Unsupported("a message's own text layout (`text:`)")
-    if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
-        raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
-    if text.checksum is not None and text.checksum_format == "decimal":
-        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
-    if text.checksum is not None and text.checksum_directions != ("request", "response"):
-        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
-    if text.checksum is not None and text.checksum_separated:
-        raise Unsupported("a separator before the text checksum (`checksum.separated`)")
-    if text.response_start:
-        raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
-    if text.address is not None:
-        raise Unsupported("an address before the text code (`framing.address`)")
+    refuse_text_frames(text)
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [

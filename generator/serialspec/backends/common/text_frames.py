@@ -1,0 +1,31 @@
+"""What of a text protocol (`framing: {kind: text}`) the C and Wireshark targets cannot generate yet: one list, so the
+two say the same one line (backends.Unsupported) for the same spec."""
+
+from __future__ import annotations
+
+from serialspec.backends import Unsupported
+from serialspec.lang.model import TextField, TextFrame
+
+
+def refuse_text_frames(text: TextFrame) -> None:
+    """Unsupported naming the first text feature neither the C nor the Wireshark target generates."""
+    if not text.start:
+        raise Unsupported("text frames without a start character (every line a frame)")
+    if any(c > "\x7f" for c in text.end):
+        raise Unsupported("a line ending with bytes above 0x7F (`end`)")
+    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
+        raise Unsupported("a text field to the end of the line (`size: rest`)")
+    if any(m.layout is not None for m in text.messages):
+        raise Unsupported("a message's own text layout (`text:`)")
+    if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
+        raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
+    if text.checksum is not None and text.checksum_format == "decimal":
+        raise Unsupported("a text checksum written in decimal (`format: decimal`)")
+    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+        raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
+    if text.checksum is not None and text.checksum_separated:
+        raise Unsupported("a separator before the text checksum (`checksum.separated`)")
+    if text.response_start:
+        raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
+    if text.address is not None:
+        raise Unsupported("an address before the text code (`framing.address`)")

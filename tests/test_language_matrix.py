@@ -621,6 +621,8 @@ CASES["frame: plain values, a sequence"] = Case(
         }
     },
 )
+# The waits a client keeps: the silence between frames (`gap`) and the turnaround after a broadcast
+CASES["frame: gap and turnaround"] = Case({"v": "u16"}, {"w": "u8"}, {**FRAMING, "gap": 3.5, "turnaround": 0.01})
 # Constant and default bit fields (`const`, `default`): in a frame value (a sync nibble; no argument needed) and in
 # a content field; decode refuses another constant, encode writes it
 CASES["frame: constant and default bit fields"] = Case(

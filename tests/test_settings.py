@@ -16,7 +16,9 @@ def test_settings_are_a_frozen_value() -> None:
     assert settings == SerialSettings(115200, 8, "even", 1, 0.0)
     assert settings != SerialSettings(baudrate=9600, parity="even")
     assert hash(settings) == hash(SerialSettings(115200, parity="even"))
-    assert repr(settings) == "SerialSettings(baudrate=115200, bytesize=8, parity='even', stopbits=1, gap=0.0)"
+    assert repr(settings) == (
+        "SerialSettings(baudrate=115200, bytesize=8, parity='even', stopbits=1, gap=0.0, turnaround=0.0)"
+    )
     assert pickle.loads(pickle.dumps(settings)) == settings
     with pytest.raises(dataclasses.FrozenInstanceError):
         settings.baudrate = 9600

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "3b504b6ff1edd22f0e8a4d89e5d6c79ee60ca83b5ba6311e8dc02a059e4c5264"
+#define DYNAMIXEL_P2_SPEC_SHA256 "f692727a14399754218eb18cf9cac00198c921d8a42b1d3c49c5ff5dc0e6279f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

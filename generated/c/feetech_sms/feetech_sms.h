@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "830563caa75cb1c18073bc8cf352aad900c31626434f5aa435058f5c0bd8df79"
+#define FEETECH_SMS_SPEC_SHA256 "a86cd9effa4470f1e054ada56e14cd3327d0777725fd6b1686e1d295b5d1679a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

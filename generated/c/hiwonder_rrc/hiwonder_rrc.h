@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "81399eb05369b74db6efccad3a598c95c93ea70a169d0bd85c479b983bff622f"
+#define HIWONDER_RRC_SPEC_SHA256 "d45873186d424a375d1737c1c9da8cce54df9d21ad28c91ad79ed1b54baa258b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

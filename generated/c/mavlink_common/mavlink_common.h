@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "194f210863aec5096b4bba4ae321d56b0eb4c17e9153bcef4b8c222701792b0e"
+#define MAVLINK_COMMON_SPEC_SHA256 "dabb43f21d9f4492348c157ec28756ceb4382392658c474aec63885dfd30c91b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

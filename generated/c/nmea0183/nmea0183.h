@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "39bba6cbcf4ee3270bf634d5d7b87059c133cc9764cf4167fac0ffa902595b22"
+#define NMEA0183_SPEC_SHA256 "b50f0eceea9997d7c86f0d7ba5f980852959573886b2feb1e4e7abe07173229a"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

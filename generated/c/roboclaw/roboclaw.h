@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "dc99ab541ff11db57e9f184522c6f145f58efb6c956239e0cf721362518146e6"
+#define ROBOCLAW_SPEC_SHA256 "1e321f5dfffcf2be2f175a3be1a8a1784450893ceffa78f53d1a9906da86a355"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

@@ -22,7 +22,7 @@ PROTOCOL = 'modbus_ascii'
 SPEC = 'specs/modbus_ascii.yaml'
 BAUDRATE = 19200
 #: The spec's serial settings: the defaults a Bus opens a port with.
-SERIAL = SerialSettings(baudrate=19200, bytesize=7, parity='even', stopbits=1.0)
+SERIAL = SerialSettings(baudrate=19200, bytesize=7, parity='even', stopbits=1.0, turnaround=0.1)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('unit', 'command')
 #: What `serialspec decode` shows of a frame without reading the spec: the directions whose frames carry a checksum

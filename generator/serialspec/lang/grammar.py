@@ -1286,6 +1286,12 @@ FRAMING = Obj(
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
+        "turnaround": Num(
+            "Seconds the client waits after a request no device answers (one sent to the address element's "
+            "`broadcast` value) before it writes again, so that every device has carried it out (Modbus serial line "
+            "§2.4.1's turnaround delay, typically 100 to 200 ms). 0: no wait beyond `gap`.",
+            example=0.1,
+        ),
         "description": TEXT,
         "kind": Str(
             "binary: frames of bytes described by `elements` or `layouts`; text: line-oriented text frames "

@@ -128,6 +128,8 @@ class AsyncBus:
             self.sync._ensure_open()
             self.sync._drain()
             await self._write(frame)
+            if self.sync._turnaround:  # no device answers: every one carries it out before the next request
+                self.sync._quiet_until = time.monotonic() + self.sync._turnaround
 
     async def request(
         self, request: Message, expect: type[M], *, timeout: float | None = None, frame: bytes | None = None
@@ -215,8 +217,8 @@ class AsyncBus:
 
     async def _write(self, frame: bytes) -> None:
         bus = self.sync
-        if bus._gap:  # the silence the protocol needs before a frame, slept without blocking the loop
-            wait = bus._last_io + bus._gap - time.monotonic()
+        if bus._paced:  # the silence the protocol needs before a frame, slept without blocking the loop
+            wait = max(bus._last_io + bus._gap, bus._quiet_until) - time.monotonic()
             if wait > 0:
                 await asyncio.sleep(wait)
         try:

@@ -11,23 +11,31 @@ class SerialSettings:
     """The spec's `serial:` section: defaults for opening a port. Frozen, compared and hashed by its values (a plain
     class rather than a dataclass: importing dataclasses would cost a generated package's import more than the rest)."""
 
-    __slots__ = ("baudrate", "bytesize", "parity", "stopbits", "gap")
-    __match_args__ = ("baudrate", "bytesize", "parity", "stopbits", "gap")
+    __slots__ = ("baudrate", "bytesize", "parity", "stopbits", "gap", "turnaround")
+    __match_args__ = ("baudrate", "bytesize", "parity", "stopbits", "gap", "turnaround")
 
     baudrate: int
     bytesize: int
     parity: str
     stopbits: float
     gap: float  # silence the protocol needs between frames, in character times (Modbus RTU: 3.5)
+    turnaround: float  # seconds a client waits after a request no device answers (a broadcast) before the next
 
     def __init__(
-        self, baudrate: int, bytesize: int = 8, parity: str = "none", stopbits: float = 1, gap: float = 0.0
+        self,
+        baudrate: int,
+        bytesize: int = 8,
+        parity: str = "none",
+        stopbits: float = 1,
+        gap: float = 0.0,
+        turnaround: float = 0.0,
     ) -> None:
-        for name, value in zip(self.__slots__, (baudrate, bytesize, parity, stopbits, gap), strict=True):
+        values = (baudrate, bytesize, parity, stopbits, gap, turnaround)
+        for name, value in zip(self.__slots__, values, strict=True):
             object.__setattr__(self, name, value)
 
     def _values(self) -> tuple[Any, ...]:
-        return (self.baudrate, self.bytesize, self.parity, self.stopbits, self.gap)
+        return (self.baudrate, self.bytesize, self.parity, self.stopbits, self.gap, self.turnaround)
 
     def __eq__(self, other: object) -> bool:
         if other.__class__ is not self.__class__:

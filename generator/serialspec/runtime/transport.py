@@ -439,6 +439,9 @@ class Bus:
         self._link = link(self._port)
         self._gap = _gap_seconds(binding.serial.gap, self._port)
         self._last_io = 0.0  # when a byte was last written or read (for the inter-frame gap)
+        self._turnaround = binding.serial.turnaround  # the wait after a request no device answers
+        self._quiet_until = 0.0  # nothing is written before then (the turnaround after such a request)
+        self._paced = bool(self._gap or self._turnaround)  # whether a write may have to wait
         # the spec's matching rule, split once: compare the command, the sub-command, then these fields
         match_by = binding.match_by
         self._match_command = "command" in match_by
@@ -501,6 +504,8 @@ class Bus:
             self._ensure_open()
             self._drain()
             self._write(frame)
+            if self._turnaround:  # no device answers: every one carries it out before the next request
+                self._quiet_until = time.monotonic() + self._turnaround
 
     def request(
         self, request: Message, expect: type[M], *, timeout: float | None = None, frame: bytes | None = None
@@ -535,7 +540,7 @@ class Bus:
             if not self.echo:
                 parser.errors = 0
                 link = self._link
-                if self._gap:
+                if self._paced:
                     self._wait_gap()
                 try:
                     stale, chunk = link.transact(frame, wait)
@@ -754,13 +759,14 @@ class Bus:
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
     def _wait_gap(self) -> None:
-        """The one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)."""
-        wait = self._last_io + self._gap - time.monotonic()
+        """The one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus), or
+        the turnaround after a request no device answers, whichever ends later."""
+        wait = max(self._last_io + self._gap, self._quiet_until) - time.monotonic()
         if wait > 0:
             time.sleep(wait)
 
     def _write(self, frame: bytes) -> None:
-        if self._gap:
+        if self._paced:
             self._wait_gap()
         try:
             self._link.write(frame)

@@ -904,6 +904,7 @@ def emit_docs(protocol: Protocol) -> str:
         has_header=any(layout.header for layout in protocol.framing.layouts.values()),
         reply_code=text(protocol.framing.reply_code),
         gap=number(protocol.framing.gap) if protocol.framing.gap else "",
+        turnaround=number(protocol.framing.turnaround) if protocol.framing.turnaround else "",
         checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),

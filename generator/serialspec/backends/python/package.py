@@ -124,6 +124,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             baudrate=protocol.serial.baudrate,
             serial=protocol.serial,
             gap=repr(protocol.framing.gap) if protocol.framing.gap else "",
+            turnaround=repr(protocol.framing.turnaround) if protocol.framing.turnaround else "",
             match_by=repr(protocol.matching),
             models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
             model_entry=protocol.device.model_entry if protocol.device else "",

@@ -139,6 +139,7 @@ class Framing:
     shared_header: bool
     alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
     gap: float = 0.0  # silence between frames, in character times (0: none defined)
+    turnaround: float = 0.0  # seconds the client waits after a request no device answers (a broadcast)
     reply_code: str = ""  # the command element's `reply_code`, as shown (`code | 0x40`): see Command.response_code
     by_command: bool = False  # a command names its layout (`layout:`): layouts are chosen by command, not by header
     # one layout's replies carry no code, differ in size, and nothing in the frame sizes them (no length element, no

@@ -117,9 +117,17 @@ class FramingPass(FieldResolver):
             checksum=checksums[0] if checksums else None,
             shared_header=first[Direction.REQUEST].header == first[Direction.RESPONSE].header,
             alternatives={d: tuple(layouts) for d, layouts in alternatives.items()},
-            gap=float(value.get("gap", 0.0)),
+            gap=self.seconds_or_characters(value, "gap", path),
+            turnaround=self.seconds_or_characters(value, "turnaround", path),
             by_command=by_command,
         )
+
+    def seconds_or_characters(self, value: dict[str, Any], key: str, path: Path) -> float:
+        """`gap` or `turnaround`: a time to wait, never negative (the grammar has checked it is a finite number)."""
+        given = float(value.get(key, 0.0))
+        if given < 0:
+            raise self.fail((*path, key), f"expected a time of 0 or more, got {value[key]}")
+        return given
 
     def error_layout(
         self, raw: dict[str, Any], response: FrameLayout, elements_path: Path, by_command: bool

@@ -42,7 +42,7 @@ KIND_KEYS = {
     "date": set(),
 }
 COMMON_KEYS = {"type", "use", "description", "unit", "label"}
-BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
+BINARY_ONLY = ("elements", "layouts", "transparency", "gap", "turnaround")
 TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length", "address")
 NOT_YET = ("matching", "enums", "flags", "tables", "errata")
 # What a text device may say (the binary device's memory, ids, models and behaviours are not available yet)

@@ -64,3 +64,16 @@ def test_a_client_drives_the_simulated_odrive(odrive: ModuleType) -> None:
             client.write("axis0.controller.config.vel_limit", 20)
     finally:
         simulator.close()
+
+
+def test_the_simulated_odrive_answers_with_a_checksum_only_when_asked_with_one(odrive: ModuleType) -> None:
+    """The docs: a line that ends with a checksum is answered with one; a line without one, without one (a driver
+    that sends none would read `24.1*25` as the value)."""
+    simulator = importlib.import_module("odrive_v05.simulator").SIMULATOR()
+    asked = odrive.ReadRequest(property="vbus_voltage")
+    try:
+        assert [reply for _, reply in simulator.feed(b"r vbus_voltage\n")] == [b"24.100000\n"]
+        (checked,) = [reply for _, reply in simulator.feed(b"r vbus_voltage *93\n")]
+        assert checked.startswith(b"24.100000*") and odrive.decode(checked, "response", request=asked).value == Decimal("24.1")
+    finally:
+        simulator.close()

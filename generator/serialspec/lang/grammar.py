@@ -1343,7 +1343,8 @@ FRAMING = Obj(
                 ),
                 "required": Bool(
                     "Frames without a checksum are refused (false: accepted unchecked, as NMEA 0183 allows for "
-                    "some sentences).",
+                    "some sentences; a message decoded without one is encoded again without one, and the simulator "
+                    "answers a request sent without one without one, as the ODrive does).",
                     default=True,
                     example=False,
                 ),

@@ -660,6 +660,8 @@ class Engine(FaultInjection):
             address = int(values[self.spec.address])
             values = {**values, self.spec.address: self._answering_as.other_id(address, self.spec.broadcast)}
         values = _whole(values)
+        if getattr(self._request, "unchecked", False) and hasattr(response, "unchecked"):
+            values["unchecked"] = True  # asked without its optional checksum: answered without one (ODrive)
         try:
             reply = response.from_fields(values)  # type: ignore[attr-defined]
             if self._requests and self._request is not None:

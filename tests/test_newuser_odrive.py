@@ -74,6 +74,7 @@ def test_the_simulated_odrive_answers_with_a_checksum_only_when_asked_with_one(o
     try:
         assert [reply for _, reply in simulator.feed(b"r vbus_voltage\n")] == [b"24.100000\n"]
         (checked,) = [reply for _, reply in simulator.feed(b"r vbus_voltage *93\n")]
-        assert checked.startswith(b"24.100000*") and odrive.decode(checked, "response", request=asked).value == Decimal("24.1")
+        assert checked.startswith(b"24.100000*")
+        assert odrive.decode(checked, "response", request=asked).value == Decimal("24.1")
     finally:
         simulator.close()

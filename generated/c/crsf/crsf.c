@@ -303,7 +303,7 @@ static const uint8_t *crsf__range(const crsf__layout_t *L, const crsf__where_t *
 static int crsf__wrap(const crsf__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    crsf__where_t w;
+    crsf__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = crsf__inner_first(L);
@@ -1571,7 +1571,7 @@ static int crsf__decode_content(crsf_direction_t dir, long code, crsf_kind_t exp
 
 int crsf_decode_expect(const uint8_t *frame, size_t len, crsf_direction_t dir, crsf_kind_t expect, crsf_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[CRSF__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

@@ -303,7 +303,7 @@ static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const
 static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    dynamixel_p2__where_t w;
+    dynamixel_p2__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = dynamixel_p2__inner_first(L);
@@ -1302,7 +1302,7 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
 
 int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_direction_t dir, dynamixel_p2_kind_t expect, dynamixel_p2_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

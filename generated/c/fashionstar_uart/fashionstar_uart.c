@@ -299,7 +299,7 @@ static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *
 static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    fashionstar_uart__where_t w;
+    fashionstar_uart__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = fashionstar_uart__inner_first(L);
@@ -2389,7 +2389,7 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
 
 int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar_uart_direction_t dir, fashionstar_uart_kind_t expect, fashionstar_uart_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

@@ -299,7 +299,7 @@ static const uint8_t *feetech_sms__range(const feetech_sms__layout_t *L, const f
 static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    feetech_sms__where_t w;
+    feetech_sms__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = feetech_sms__inner_first(L);
@@ -1112,7 +1112,7 @@ static int feetech_sms__decode_content(feetech_sms_direction_t dir, long code, f
 
 int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_direction_t dir, feetech_sms_kind_t expect, feetech_sms_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

@@ -303,7 +303,7 @@ static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const
 static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    hiwonder_rrc__where_t w;
+    hiwonder_rrc__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = hiwonder_rrc__inner_first(L);
@@ -2308,7 +2308,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
 
 int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_direction_t dir, hiwonder_rrc_kind_t expect, hiwonder_rrc_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

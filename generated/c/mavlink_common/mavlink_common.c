@@ -349,7 +349,7 @@ static const uint8_t *mavlink_common__range(const mavlink_common__layout_t *L, c
 static int mavlink_common__wrap(const mavlink_common__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    mavlink_common__where_t w;
+    mavlink_common__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = mavlink_common__inner_first(L);
@@ -1874,7 +1874,7 @@ static int mavlink_common__decode_content(mavlink_common_direction_t dir, long c
 
 int mavlink_common_decode_expect(const uint8_t *frame, size_t len, mavlink_common_direction_t dir, mavlink_common_kind_t expect, mavlink_common_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     const uint8_t *extras[1];
     uint32_t code = 0u, values[MAVLINK_COMMON__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;

@@ -361,7 +361,7 @@ static const uint8_t *modbus_ascii__range(const modbus_ascii__layout_t *L, const
 static int modbus_ascii__wrap(const modbus_ascii__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    modbus_ascii__where_t w;
+    modbus_ascii__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = modbus_ascii__inner_first(L);
@@ -1610,7 +1610,7 @@ static int modbus_ascii__decode_content(modbus_ascii_direction_t dir, long code,
 
 int modbus_ascii_decode_expect(const uint8_t *frame, size_t len, modbus_ascii_direction_t dir, modbus_ascii_kind_t expect, modbus_ascii_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[MODBUS_ASCII__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

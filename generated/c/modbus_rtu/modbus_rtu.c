@@ -303,7 +303,7 @@ static const uint8_t *modbus_rtu__range(const modbus_rtu__layout_t *L, const mod
 static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    modbus_rtu__where_t w;
+    modbus_rtu__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = modbus_rtu__inner_first(L);
@@ -1603,7 +1603,7 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
 
 int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direction_t dir, modbus_rtu_kind_t expect, modbus_rtu_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

@@ -304,7 +304,7 @@ static int roboclaw__wrap(const roboclaw__layout_t *L, uint8_t *out, size_t cap,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len,
                      const uint8_t *pre, size_t pre_n)
 {
-    roboclaw__where_t w;
+    roboclaw__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = roboclaw__inner_first(L);
@@ -2364,7 +2364,7 @@ static int roboclaw__decode_content(roboclaw_direction_t dir, long code, robocla
 static int roboclaw__decode_with(const uint8_t *frame, size_t len, roboclaw_direction_t dir, roboclaw_kind_t expect,
                             const uint8_t *pre, size_t pre_n, roboclaw_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[ROBOCLAW__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

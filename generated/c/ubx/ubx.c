@@ -301,7 +301,7 @@ static const uint8_t *ubx__range(const ubx__layout_t *L, const ubx__where_t *w, 
 static int ubx__wrap(const ubx__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    ubx__where_t w;
+    ubx__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = ubx__inner_first(L);
@@ -1527,7 +1527,7 @@ static int ubx__decode_content(ubx_direction_t dir, long code, ubx_kind_t expect
 
 int ubx_decode_expect(const uint8_t *frame, size_t len, ubx_direction_t dir, ubx_kind_t expect, ubx_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[UBX__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

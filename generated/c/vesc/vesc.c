@@ -303,7 +303,7 @@ static const uint8_t *vesc__range(const vesc__layout_t *L, const vesc__where_t *
 static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    vesc__where_t w;
+    vesc__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = vesc__inner_first(L);
@@ -1572,7 +1572,7 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
 
 int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, vesc_kind_t expect, vesc_msg_t *out)
 {
-    uint8_t count, k;
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */
     uint32_t code = 0u, values[VESC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;

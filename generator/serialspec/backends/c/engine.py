@@ -221,7 +221,7 @@ static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, 
 static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
                      const uint32_t *values, const uint8_t *const *extras, size_t *len)
 {
-    pfx__where_t w;
+    pfx__where_t w = {0}; /* (each entry is set before it is read; gcc -Os cannot always tell) */
     size_t pos = 0u, i, sz;
     uint8_t k, v = 0u;
     uint8_t first = pfx__inner_first(L);

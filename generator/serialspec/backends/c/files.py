@@ -1666,7 +1666,7 @@ static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect
 
 {decode_head}
 {{
-    uint8_t count, k;{extras_decl}
+    uint8_t count, k = 0u; /* (set on every path that reads it; -Og cannot tell) */{extras_decl}
     uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
     const uint8_t *c = NULL;
     size_t clen = 0u;

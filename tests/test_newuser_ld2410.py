@@ -22,6 +22,7 @@ import pytest
 from conftest import examples, generate_and_import, simulated, spec_error
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError, EncodeError
 
 protocol = pytest.importorskip("aio_ld2410.protocol")
 
@@ -220,25 +221,43 @@ def counted_spec() -> str:
     text = SPEC.read_text("utf-8").replace("protocol: hlk_ld2410\n", "protocol: ld2410_counted\n")
     text = text.replace('{type: u8, const: 8, description: "N, the farthest moving', '{type: u8, description: "N, f')
     text = text.replace('{type: array, of: u8, count: 9, unit: "%", description: Gates 0 to N.}', "X", 1)
-    return text.replace("moving_energies: X", 'moving_energies: {type: array, of: u8, count: "max_moving_gate + 1"}')
+    text = text.replace("moving_energies: X", 'moving_energies: {type: array, of: u8, count: "max_moving_gate + 1"}')
+    return text.replace("      moving_energies: [60,", "      max_moving_gate: 8\n      moving_energies: [60,")
 
 
-def test_a_count_expression_is_one_line(tmp_path: Path) -> None:
-    """Refused in one line: the device's reply value for the field that failed said a second line once (`unknown
-    response field 'moving_energies': no response carries it`)."""
-    assert spec_error(counted_spec(), tmp_path).endswith(
-        "commands.engineering_report.response.fields.moving_energies: unknown field 'max_moving_gate + 1': a count "
-        "or size must be an earlier field of the same content"
+def test_a_count_of_a_later_field_is_one_line(tmp_path: Path) -> None:
+    """Refused in one line at the count: the device's reply value for the field that failed said a second line once
+    (`unknown response field 'moving_energies': no response carries it`)."""
+    text = counted_spec().replace('count: "max_moving_gate + 1"', 'count: "light + 1"')
+    said = spec_error(text, tmp_path)
+    assert "\n" not in said and said.endswith(
+        "commands.engineering_report.response.fields.moving_energies.count: a later field 'light' in 'light + 1': a "
+        "count or size names earlier integer fields"
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a count is a number, `rest` or a field, not an expression: LD2410's engineering report sends N + 1 "
-    "energies per gate after N (`count: max_moving_gate + 1`)",
-)
 def test_a_count_of_one_more_than_a_field(tmp_path: Path) -> None:
+    """`count: max_moving_gate + 1`: N stays in the message; decode reads N + 1 energies (the datasheet's report, N
+    = 8), encode refuses a list of another length before writing a byte, naming the count expected; construct's
+    struct reads the same; the stream parser finds frames of several N."""
     spec = tmp_path / "counted.yaml"
     spec.write_text(counted_spec(), "utf-8")
-    counted = generate_and_import(spec, tmp_path / "out", "ld2410_counted")
-    assert counted is not None
+    ld = generate_and_import(spec, tmp_path / "out", "ld2410_counted")
+    trace = bytes.fromhex(
+        "f4 f3 f2 f1 23 00 01 aa 03 1e 00 3c 00 00 39 00 00 08 08 3c 22 05 03 03 04 03 06 05 00 00 39 10"
+        "13 06 06 08 04 60 01 55 00 f8 f7 f6 f5"
+    )
+    message = ld.decode(trace, ld.Direction.RESPONSE)
+    assert message.max_moving_gate == 8 and list(message.moving_energies) == [60, 34, 5, 3, 3, 4, 3, 6, 5]
+    assert ld.encode(message) == trace
+    fields = {**message.to_fields(), "max_moving_gate": 2, "moving_energies": [1, 2, 3]}
+    fewer = ld.encode(type(message).from_fields(fields))
+    assert len(fewer) == len(trace) - 6 and ld.decode(fewer, ld.Direction.RESPONSE).moving_energies == (1, 2, 3)
+    with pytest.raises(EncodeError, match=r"moving_energies needs max_moving_gate \+ 1 = 3 items, got 4$"):
+        ld.encode(type(message).from_fields({**fields, "moving_energies": [1, 2, 3, 4]}))
+    with pytest.raises(DecodeError, match="moving_energies needs 256 bytes, 20 left$"):  # N = 255
+        ld.decode(trace[:17] + b"\xff" + trace[18:], ld.Direction.RESPONSE)
+    structs = importlib.import_module("ld2410_counted.structs")
+    assert list(structs.EngineeringReportResponseContent.parse(fewer[8:-6]).moving_energies) == [1, 2, 3]
+    parser = ld.StreamParser(ld.Direction.RESPONSE)
+    assert parser.feed(b"\xf4" + fewer + trace + fewer[:5]) == [ld.decode(fewer, ld.Direction.RESPONSE), message]

@@ -21,13 +21,14 @@ from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
 from serialspec.encodings import bit_run, seven_bit
-from serialspec.lang import expression
+from serialspec.lang import counts, expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
     Array,
     BitField,
     Bytes,
     Checksum,
+    Counted,
     Direction,
     Field,
     FrameLayout,
@@ -224,6 +225,8 @@ def refuse_unsupported(protocol: Protocol) -> None:
         for layout in layouts:
             refuse_layout(layout)
     for message in protocol.messages():
+        if (why := counts.refusal(message.fields)) is not None:
+            raise Unsupported(f"{message.key} {message.direction.value}: {why}")
         refuse_fields(message.fields, message.key)
     refuse_wide_values(protocol)
 
@@ -535,6 +538,12 @@ def as_size(ctx: Ctx, pad: str, value: str, out: list[str]) -> str:
     return f"(size_t)({value})"
 
 
+def count_size(ctx: Ctx, pad: str, count: str | Counted, scope: Scope, out: list[str]) -> str:
+    """A count or size read from a field, as size_t (a count given by an expression is refused: refuse_unsupported)."""
+    assert isinstance(count, str), count
+    return as_size(ctx, pad, scope.lookup(count), out)
+
+
 def get_raw(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
     """A scalar's wire bits: uint32_t, or uint64_t for 8-byte types (built with shifts, whatever the host)."""
     if wide(t):
@@ -655,7 +664,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 elif f.size == "rest":
                     out.append(f"{pad}len = n - o;")
                 elif f.size is not None:
-                    out.append(f"{pad}len = {as_size(ctx, pad, scope.lookup(f.size), out)};")
+                    out.append(f"{pad}len = {count_size(ctx, pad, f.size, scope, out)};")
                 if not terminated:
                     out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
                 if isinstance(f, Text) and f.pad is not None:  # the text without the pad bytes after it
@@ -699,7 +708,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 decode_fields(ctx, f.fields, item_scope, body, depth + 1)
                 capacity = f"(sizeof({tgt}) / sizeof({tgt}[0]))"
                 if isinstance(f.count, int) or f.count != "rest":
-                    count = f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                    count = f"{f.count}u" if isinstance(f.count, int) else count_size(ctx, pad, f.count, scope, out)
                     if not isinstance(f.count, int):
                         out.append(f"{pad}if ({count} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                         out.append(f"{pad}{tgt}_count = {count};")
@@ -756,9 +765,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                         out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
                     count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
                 else:
-                    number = (
-                        f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
-                    )
+                    number = f"{f.count}u" if isinstance(f.count, int) else count_size(ctx, pad, f.count, scope, out)
                     out.append(f"{pad}{tgt}_count = {number};")
                     out.append(
                         f"{pad}len = ({tgt}_count + 7u) / 8u;" if not item else f"{pad}len = {tgt}_count * {item}u;"

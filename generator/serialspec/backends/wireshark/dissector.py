@@ -15,6 +15,7 @@ from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import layout_codes, runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.encodings import bit_run, seven_bit
+from serialspec.lang import counts
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -49,6 +50,9 @@ from serialspec.runtime.framing import Layout
 
 
 def emit_dissector(protocol: Protocol) -> str:
+    for message in protocol.messages():
+        if (why := counts.refusal(message.fields)) is not None:
+            raise Unsupported(f"{message.key} {message.direction.value}: {why}")
     directions = {d.value: _direction(protocol, d) for d in protocol.framing.alternatives}
     used = {
         f.table.name

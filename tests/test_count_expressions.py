@@ -8,7 +8,9 @@ a `n + k` count, and the markdown reference showing the expression.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
@@ -193,11 +195,34 @@ def test_a_frame_without_a_length_is_sized_by_a_count_of_n_plus_k() -> None:
     )
 
 
-def test_c_and_wireshark_refuse_it_in_one_line_and_the_reference_shows_it() -> None:
-    protocol = protocol_of(spec())
-    for files in (c_files, lua_files):
-        with pytest.raises(Unsupported) as refused:
-            files(protocol)
-        assert str(refused.value) == "probe request: a count given by an expression (`items`: `count: n + 1`)"
-    page = emit_docs(protocol)
+def test_the_c_refuses_a_negative_count_and_reads_the_others(package: ModuleType, tmp_path: Path) -> None:
+    from test_c_backend import GCC, spec_driver
+
+    if GCC is None:
+        pytest.skip("no C compiler")
+    spec_file = tmp_path / "counted.yaml"
+    spec_file.write_text(spec(), "utf-8")
+    driver = spec_driver(spec_file, "counted", tmp_path)
+    try:
+        sent = package.encode(message(package))
+        said = driver.ask(f"dec request {sent.hex()}")[0]
+        assert said.startswith("ok ") and json.loads(said[3:])["fields"] == message(package).to_fields()
+        assert driver.ask(f"rt request {sent.hex()}") == [f"ok {sent.hex()}"]
+        negative = frame(bytes([0xFE, 0]))  # n = -2: n + 1 items is -1
+        said = driver.ask(f"dec request {negative.hex()}")[0]
+        assert said == "err E_CONTENT", said
+    finally:
+        driver.close()
+
+
+def test_wireshark_refuses_bit_operators_in_one_line_and_the_reference_shows_counts() -> None:
+    """Lua 5.2 has no bit operators: a count of `n & 7` is refused by the dissector alone; C generates it."""
+    protocol = protocol_of(spec('        n: u8\n        items: {type: array, of: u8, count: "n & 7"}\n'))
+    with pytest.raises(Unsupported) as refused:
+        lua_files(protocol)
+    assert str(refused.value) == (
+        "probe request: a count by an expression with bit operators (`items`: `count: n & 7`): Lua 5.2 has none"
+    )
+    assert c_files(protocol)
+    page = emit_docs(protocol_of(spec()))
     assert "u16 list × (n + 1)" in page and "group × (2 * n)" in page and "bytes (n - 1)" in page

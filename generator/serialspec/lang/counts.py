@@ -16,7 +16,7 @@ its checks (`python_value`, `python_check`), and the one line the targets that d
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.lang import expression
 from serialspec.lang.model.fields import Bytes, Counted, Field, Group, List, Scalar, Text
@@ -150,15 +150,54 @@ def unsized(fields: Sequence[Field]) -> tuple[str, str, str] | None:
     return None
 
 
-def refusal(fields: Iterable[Field]) -> str | None:
-    """The one line a target that does not generate counts by expression says for these fields, or None."""
+# The dissector's reading of a count by expression (its `count` or `size` a function of the fields read before it)
+LUA = """-- a count or size given by an expression of the fields read before it (lang/counts.py): refused when negative
+local function counted(f, count, scope)
+  local n = count(scope)
+  if n < 0 then error(string.format("%s: a negative count (%d)", f.name, n), 0) end
+  return n
+end"""
+
+
+def lua_function(count: Counted) -> str | None:
+    """A Lua function of the dissector's scope (field name -> value) giving the count; None where the expression has
+    bit operators (Lua 5.2 has none: the dissector refuses it)."""
+    body = _lua(count.expr)
+    return None if body is None else f"function(s) return {body} end"
+
+
+def _lua(expr: expression.Expr) -> str | None:
+    match expr:
+        case expression.Const():
+            return str(expr.value)
+        case expression.Name():
+            return f"s[{expr.name!r}]"
+        case expression.BinOp() if expr.op in ("+", "-", "*", "/", "%"):
+            left, right = _lua(expr.left), _lua(expr.right)
+            if left is None or right is None:
+                return None
+            return f"math.floor({left} / {right})" if expr.op == "/" else f"({left} {expr.op} {right})"
+        case expression.Ceil():
+            top, bottom = _lua(expr.numerator), _lua(expr.denominator)
+            return None if top is None or bottom is None else f"math.ceil({top} / {bottom})"
+        case expression.MinMax():
+            args = [_lua(arg) for arg in expr.args]
+            return None if None in args else f"math.{expr.function}({', '.join(a or '' for a in args)})"
+        case expression.BinOp() | expression.Invert() | expression.Length():
+            return None
+        case _:
+            assert_never(expr)
+
+
+def lua_refusal(fields: Iterable[Field]) -> str | None:
+    """The one line the Wireshark dissector says for a count by an expression with bit operators, or None."""
     for field in fields:
         count = counted(field)
-        if count is not None:
+        if count is not None and lua_function(count) is None:
             key = "count" if isinstance(field, List | Group) else "size"
-            return f"a {key} given by an expression (`{field.name}`: `{key}: {count}`)"
+            return f"a {key} by an expression with bit operators (`{field.name}`: `{key}: {count}`): Lua 5.2 has none"
         if isinstance(field, Group):
-            inner = refusal(field.fields)
+            inner = lua_refusal(field.fields)
             if inner is not None:
                 return inner
     return None

@@ -577,8 +577,8 @@ FIELD = OneOf(
                     "keep the expression limits and cannot all be negative; one that may divide by 0 or shift by a "
                     "field is refused. A frame with no length element, trailer or stuffing is sized by a count "
                     "`k * field + m` (k >= 1, m >= 0) of fixed-size items; another expression there is refused in one "
-                    "line. The C target and the Wireshark dissector do not generate counts by expression yet: they "
-                    "refuse the spec in one line (the other outputs are written).",
+                    "line. The C computes it in int64_t (docs/c.md); the Wireshark dissector refuses a count with bit "
+                    "operators (`& | << >> ~`: Lua 5.2 has none) in one line.",
                 ),
             ),
         ),

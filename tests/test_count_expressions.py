@@ -185,14 +185,16 @@ def test_a_frame_without_a_length_is_sized_by_a_count_of_n_plus_k() -> None:
         assert [len(m.items) for m in found] == [1, 7]
         parser = package.StreamParser("request")
         assert [m for byte in wire for m in parser.feed(bytes([byte]))] == found
-    text = spec('        n: u8\n        items: {type: array, of: u16, count: "n - 1"}\n', NO_LENGTH)
-    with pytest.raises(SpecErrors) as refused:
-        protocol_of(text)
-    row = len(text.splitlines())
-    assert str(refused.value) == (
-        f"counted.yaml:{row}:46: commands.probe.request.fields.items.count: 'n - 1' cannot size a frame that has no "
-        "length element (a stream parser sizes such frames by a count `k * field + m` of fixed-size items before them)"
-    )
+    for item, count in (("u16", "n - 1"), ("bit", "n + 1")):  # not k * n + m; bits (not whole bytes an item)
+        text = spec(f'        n: u8\n        items: {{type: array, of: {item}, count: "{count}"}}\n', NO_LENGTH)
+        with pytest.raises(SpecErrors) as refused:
+            protocol_of(text)
+        row, column = len(text.splitlines()), text.splitlines()[-1].index("count") + 8
+        assert str(refused.value) == (
+            f"counted.yaml:{row}:{column}: commands.probe.request.fields.items.count: '{count}' cannot size a frame "
+            "that has no length element (a stream parser sizes such frames by a count `k * field + m` of items of "
+            "one size before them)"
+        )
 
 
 def test_the_c_refuses_a_negative_count_and_reads_the_others(package: ModuleType, tmp_path: Path) -> None:

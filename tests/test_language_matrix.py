@@ -872,6 +872,20 @@ CASES["requests sharing a code and one size, picked by a leading u8, no length e
         "current": {"code": 0x8E, "request": {"fields": {"packet": {"type": "u8", "const": 23}}}},
     },
 )
+# A frame with no length element sized by a count by expression before what it counts (`2 * n + 1` items of 2 bytes:
+# 2 + 4 per n), as by a count field (lang/counts.py, model/sizes.py linear): every stream parser, C's and tshark's too
+CASES["frame: no length, sized by a count expression"] = Case(
+    {"n": {"type": "u8", "range": [0, 3]}, "items": {"type": "array", "of": "u16", "count": "2 * n + 1"}},
+    {"m": "u8", "items": {"type": "array", "of": "u8", "count": "m + 2"}},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        }
+    },
+)
 CASES["requests sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u16"},

@@ -8,9 +8,12 @@ gate, beyond the count): decode works the expression out to know how many items 
 negative count in one line; encode refuses a list, group, bytes or text whose length differs from the expression's
 value before writing a byte, naming the field and the count expected.
 
-This module owns the feature: parsing and checking it (`parse`, `resolve`), the Python source of its value and of
-its checks (`python_value`, `python_check`), and the one line the targets that do not generate it say
-(`refusal`). The model holds it as `Counted` (model/fields.py).
+This module owns the feature: parsing and checking it (`parse`, `resolve`; `unsized` where a frame without a length
+cannot be sized by it), the Python codec's source of its value and of its refusals (`python_value`, `python_reason`,
+`python_encode_reason`), construct's count (`construct_count`), the simulator's blank (`python_blank`, runtime
+CountedBlank), the dissector's Lua (`LUA`, `lua_function`, `lua_refusal`). The model holds it as `Counted`
+(model/fields.py), the stream parsers' sizing as a linear count (model/sizes.py `linear`); the C renders it with the
+C backend's expression renderer (backends/c/emit.py count_size, check_fields).
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from typing import Any, assert_never
 
 from serialspec.lang import expression
 from serialspec.lang.model.fields import Bytes, Counted, Field, Group, List, Scalar, Text
-from serialspec.lang.model.sizes import linear, sized_by_itself
+from serialspec.lang.model.sizes import counted_term, sized_by_itself
 
 
 class CountError(ValueError):
@@ -131,20 +134,20 @@ def least(count: Counted, values: dict[str, int]) -> int:
 
 def unsized(fields: Sequence[Field]) -> tuple[str, str, str] | None:
     """Where a frame with no length, trailer or stuffing is sized by its content's own bytes: the first count by
-    an expression the stream parser cannot size it by (not `times * field + plus`, model/sizes.py linear) where
-    the content does not size itself, as (field, key, the one line saying so); None where there is none."""
+    an expression the stream parser cannot size it by (not `k * field + m` items of a fixed size, model/sizes.py
+    counted_term) where the content does not size itself, as (field, key, the one line saying so); else None."""
     if sized_by_itself(tuple(fields)):
         return None
     for field in fields:
         count = counted(field)
-        if count is not None and linear(count) is None:
+        if isinstance(field, List | Group | Bytes | Text) and count is not None and counted_term(field) is None:
             key = "count" if isinstance(field, List | Group) else "size"
             return (
                 field.name,
                 key,
                 (
                     f"{expression.show(count.expr)!r} cannot size a frame that has no length element (a stream parser "
-                    "sizes such frames by a count `k * field + m` of fixed-size items before them)"
+                    "sizes such frames by a count `k * field + m` of items of one size before them)"
                 ),
             )
     return None

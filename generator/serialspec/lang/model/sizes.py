@@ -117,6 +117,21 @@ def linear(count: Counted) -> tuple[str, int, int] | None:
     return (expr.name, times, plus) if isinstance(expr, expression.Name) else None
 
 
+def counted_term(item: List | Group | Bytes | Text) -> tuple[str, int, int] | None:
+    """A field counted by an expression, as a stream parser sizes it: (field, bytes per unit of it, bytes more), for
+    `k * n + m` items of a fixed size (`n + 1` u16s: 2 per n, 2 more); None for another expression or items of
+    varying size (or bits)."""
+    count = counted_by(item)
+    assert isinstance(count, Counted)
+    found = linear(count)
+    unit = 1 if isinstance(item, Bytes | Text) else item.item_size if isinstance(item, Group) else None
+    if isinstance(item, List) and item.item is not None:
+        unit = item.item.size
+    if found is None or unit is None:
+        return None
+    return found[0], found[1] * unit, found[2] * unit
+
+
 def byte_size_expression(item: List) -> Expr | None:
     """The size in bytes of a list counted by a field, as an expression of that field (ceil(n / 8), n * 2)."""
     if not isinstance(item.count, str) or item.count in ("", "rest"):
@@ -146,16 +161,12 @@ def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, st
         offset = None
         sizer: str = ""
         factor = 1
-        c = counted_by(item) if isinstance(item, List | Group | Bytes | Text) else None
-        if isinstance(c, Counted):  # `n + 1` items of a fixed size: n * size + size bytes
-            unit = 1 if isinstance(item, Bytes | Text) else (item.item_size if isinstance(item, Group) else None)
-            if isinstance(item, List) and item.item is not None:
-                unit = item.item.size
-            found = linear(c)
-            if found is None or unit is None:
+        if isinstance(item, List | Group | Bytes | Text) and isinstance(counted_by(item), Counted):
+            term = counted_term(item)
+            if term is None:
                 return None
-            sizer, factor = found[0], found[1] * unit
-            fixed += found[2] * unit
+            sizer, factor, plus = term
+            fixed += plus
         elif isinstance(item, List):
             wanted = byte_size_expression(item)
             same = next((name for name, (_, f) in offsets.items() if wanted is not None and f.value == wanted), "")

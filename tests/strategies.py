@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from hypothesis import strategies as st
+from serialspec.lang import counts, expression
 from serialspec.lang.model import (
     Array,
     BitField,
@@ -83,7 +84,10 @@ def _fields_values(
     values: dict[str, Any] = {}
     sizes: dict[str, int] = {}
     for f in fields:
-        if isinstance(f, Scalar):
+        counted = counts.counted(f)
+        if counted is not None:  # as many items or bytes as the expression makes of the values drawn before it
+            values[f.name] = draw(counted_value(f, expression.evaluate(counted.expr, values), scope))
+        elif isinstance(f, Scalar):
             if f.hidden:
                 continue
             values[f.name] = draw(scalar_value(f))
@@ -151,6 +155,24 @@ def _fields_values(
                 st.fixed_dictionaries({e.name: number(e.type, e.minimum, e.maximum) for e in f.entries})
             )
     return values
+
+
+def counted_value(f: Field, n: int, scope: Mapping[str, Field]) -> st.SearchStrategy[Any]:
+    """A value of `n` items (a list, a group) or bytes (bytes, text): a field counted by an expression."""
+    chars = st.characters(min_codepoint=0x20, max_codepoint=0x7E)
+    match f:
+        case List():
+            item = st.booleans() if f.item is None else number(f.item, f.minimum, f.maximum)
+            return st.lists(item, min_size=n, max_size=n)
+        case Group():
+            return st.lists(fields_values(f.fields, 0, scope), min_size=n, max_size=n)
+        case Bytes():
+            return st.binary(min_size=n, max_size=n).map(lambda b: b.hex(" "))
+        case Text() if f.seven_bit:
+            return st.text(chars, min_size=n // 2, max_size=n // 2)
+        case Text():
+            return st.text(chars, min_size=n, max_size=n)
+    raise AssertionError(f"{f.name} is not counted")
 
 
 def list_value(

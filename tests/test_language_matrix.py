@@ -155,6 +155,22 @@ CASES: dict[str, Case] = {
         }
     ),
     "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
+    # counts and sizes by expression (lang/counts.py): n stays in the message; a frame with n = 0 has no count
+    "count and size expressions": same(
+        {
+            "n": {"type": "u8", "range": [1, 4], "default": 2},
+            "items": {"type": "array", "of": "u16", "count": "n - 1"},
+            "bits": {"type": "array", "of": "bit", "count": "2 * n"},
+            "g": {
+                "type": "group",
+                "count": "n + 1",
+                "fields": {"a": "u8", "k": {"type": "u8", "range": [0, 5]}, "d": {"type": "bytes", "size": "k % 3"}},
+            },
+            "data": {"type": "bytes", "size": "max(n, 2)"},
+            "name": {"type": "string", "size": "n * 2"},
+            "tail": "u8",
+        }
+    ),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),
     "strings in group items": same(
@@ -858,6 +874,20 @@ CASES["requests sharing a code and one size, picked by a leading u8, no length e
         "current": {"code": 0x8E, "request": {"fields": {"packet": {"type": "u8", "const": 23}}}},
     },
 )
+# A frame with no length element sized by a count by expression before what it counts (`2 * n + 1` items of 2 bytes:
+# 2 + 4 per n), as by a count field (lang/counts.py, model/sizes.py linear): every stream parser, C's and tshark's too
+CASES["frame: no length, sized by a count expression"] = Case(
+    {"n": {"type": "u8", "range": [0, 3]}, "items": {"type": "array", "of": "u16", "count": "2 * n + 1"}},
+    {"m": "u8", "items": {"type": "array", "of": "u8", "count": "m + 2"}},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        }
+    },
+)
 CASES["requests sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u16"},
@@ -1276,7 +1306,10 @@ def test_every_documented_alternative_has_a_case() -> None:
                     used[key].add(spec[key])
             for key in ("size", "count"):
                 if key in spec:
-                    used[key].add("rest" if spec[key] == "rest" else type(spec[key]).__name__)
+                    plain = not isinstance(spec[key], str) or spec[key].isidentifier()
+                    used[key].add(
+                        "rest" if spec[key] == "rest" else type(spec[key]).__name__ if plain else "expression"
+                    )
             walk_fields(spec.get("fields", {}))
 
     for case in CASES.values():
@@ -1310,8 +1343,8 @@ def test_every_documented_alternative_has_a_case() -> None:
     )
     assert set(field["encoding"].choices) - used["encoding"] == set()  # type: ignore[attr-defined]
     assert set(field["endian"].choices) - used["endian"] == set()  # type: ignore[attr-defined]
-    assert {"rest", "int", "str"} - used["size"] == set()
-    assert {"rest", "int", "str"} - used["count"] == set()
+    assert {"rest", "int", "str", "expression"} - used["size"] == set()
+    assert {"rest", "int", "str", "expression"} - used["count"] == set()
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
     assert {"u8", "u16", "u24"} - used["element type"] == set()
     assert any(bit_run.width(t) for t in used["type"])  # a bit field (uN/iN of another width)

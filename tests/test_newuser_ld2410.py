@@ -6,8 +6,9 @@ to the generated simulator. Commands and ACKs (FD FC FB FA, a u16 command word, 
 command element was applied to the reports too: `encode` of a basic report said `type = 258 does not fit 1 byte(s)`
 and decoding the datasheet's report said `unknown command 0x02`; the reference said the report's type byte was the
 ACK's code. A bug, fixed: where layouts are chosen by command, only the layouts whose command element gives
-`reply_code` compute it. Engineering reports carry N + 1 energies per gate after N: the count is fixed at 9 here
-(N is 8 on the LD2410), since a count is a number or a field, not an expression (a strict xfail below)."""
+`reply_code` compute it. Engineering reports carry N + 1 energies per gate after N (N is 8 on the LD2410): a count
+was a number or a field, so the spec fixed it at 9 (a strict xfail); the spec now counts them `max_moving_gate + 1`
+(counts by expression, lang/counts.py), N staying in the message, and the Python, the C and the peer agree."""
 
 from __future__ import annotations
 
@@ -22,11 +23,17 @@ import pytest
 from conftest import examples, generate_and_import, simulated, spec_error
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError, EncodeError
 
 protocol = pytest.importorskip("aio_ld2410.protocol")
 
 SPEC = Path(__file__).parent / "specs" / "hlk_ld2410.yaml"
 Code = protocol.CommandCode
+# aio-ld2410's test trace: the datasheet's engineering report with the light sensor's value and the OUT pin (60 01)
+TRACE = bytes.fromhex(
+    "f4 f3 f2 f1 23 00 01 aa 03 1e 00 3c 00 00 39 00 00 08 08 3c 22 05 03 03 04 03 06 05 00 00 39 10"
+    "13 06 06 08 04 60 01 55 00 f8 f7 f6 f5"
+)
 
 
 @pytest.fixture(scope="module")
@@ -127,7 +134,13 @@ def test_the_peer_parses_our_reports(
     )
     if engineering:
         message = ld.EngineeringReportResponse(
-            **basic, moving_energies=moving, stationary_energies=stationary, light=light, out_pin=1
+            **basic,
+            max_moving_gate=8,
+            max_stationary_gate=8,
+            moving_energies=moving,
+            stationary_energies=stationary,
+            light=light,
+            out_pin=1,
         )
     else:
         message = ld.BasicReportResponse(**basic)
@@ -144,16 +157,12 @@ def test_the_peer_parses_our_reports(
     assert ld.decode(frame, ld.Direction.RESPONSE) == message
 
 
-def test_the_peers_own_engineering_trace(ld: ModuleType) -> None:
-    """aio-ld2410's test trace: the datasheet's report with the light sensor's value and the OUT pin (60 01) where the
+def test_the_peers_own_engineering_TRACE(ld: ModuleType) -> None:
+    """aio-ld2410's test TRACE: the datasheet's report with the light sensor's value and the OUT pin (60 01) where the
     datasheet prints retained bytes."""
-    trace = bytes.fromhex(
-        "f4 f3 f2 f1 23 00 01 aa 03 1e 00 3c 00 00 39 00 00 08 08 3c 22 05 03 03 04 03 06 05 00 00 39 10"
-        "13 06 06 08 04 60 01 55 00 f8 f7 f6 f5"
-    )
-    message = ld.decode(trace, ld.Direction.RESPONSE)
+    message = ld.decode(TRACE, ld.Direction.RESPONSE)
     assert (message.target_state, message.moving_distance, message.light, message.out_pin) == (3, 30, 0x60, 1)
-    assert ld.encode(message) == trace
+    assert ld.encode(message) == TRACE
 
 
 def test_a_layout_without_reply_code_keeps_its_codes(ld: ModuleType) -> None:
@@ -199,7 +208,7 @@ def test_the_generated_client_configures_the_sim(ld: ModuleType, sim_path: str) 
         assert list(engineering.stationary_energies) == [0, 10, 45, 20, 5, 0, 0, 0, 0]
 
 
-def test_the_c_reads_the_reports_and_acks(tmp_path: Path) -> None:
+def test_the_c_reads_the_reports_and_acks(ld: ModuleType, tmp_path: Path) -> None:
     from test_c_backend import GCC, spec_driver
 
     if GCC is None:
@@ -211,34 +220,59 @@ def test_the_c_reads_the_reports_and_acks(tmp_path: Path) -> None:
         assert json.loads(said[3:])["fields"]["stationary_energy"] == 59
         said = driver.ask("dec response fdfcfbfa0400fe01000004030201")[0]
         assert said.startswith("ok ") and json.loads(said[3:])["command"] == "end_configuration"
+        # N + 1 energies after N (`count: max_moving_gate + 1`): 9, then 3 where N = 2; N = 255 asks for more bytes
+        said = driver.ask(f"dec response {TRACE.hex()}")[0]
+        assert said.startswith("ok ") and json.loads(said[3:])["fields"]["moving_energies"] == [
+            60,
+            34,
+            5,
+            3,
+            3,
+            4,
+            3,
+            6,
+            5,
+        ]
+        message = ld.decode(TRACE, ld.Direction.RESPONSE)
+        fewer = ld.encode(
+            type(message).from_fields({**message.to_fields(), "max_moving_gate": 2, "moving_energies": [1, 2, 3]})
+        )
+        said = driver.ask(f"dec response {fewer.hex()}")[0]
+        assert said.startswith("ok ") and json.loads(said[3:])["fields"]["moving_energies"] == [1, 2, 3]
+        said = driver.ask(f"rt response {fewer.hex()}")[0]
+        assert said == f"ok {fewer.hex()}", said
+        said = driver.ask(f"dec response {(TRACE[:17] + bytes([255]) + TRACE[18:]).hex()}")[0]
+        assert not said.startswith("ok "), said
     finally:
         driver.close()
 
 
-def counted_spec() -> str:
-    """The spec with the engineering report's moving energies counted as N + 1 from the field before them."""
-    text = SPEC.read_text("utf-8").replace("protocol: hlk_ld2410\n", "protocol: ld2410_counted\n")
-    text = text.replace('{type: u8, const: 8, description: "N, the farthest moving', '{type: u8, description: "N, f')
-    text = text.replace('{type: array, of: u8, count: 9, unit: "%", description: Gates 0 to N.}', "X", 1)
-    return text.replace("moving_energies: X", 'moving_energies: {type: array, of: u8, count: "max_moving_gate + 1"}')
-
-
-def test_a_count_expression_is_one_line(tmp_path: Path) -> None:
-    """Refused in one line: the device's reply value for the field that failed said a second line once (`unknown
-    response field 'moving_energies': no response carries it`)."""
-    assert spec_error(counted_spec(), tmp_path).endswith(
-        "commands.engineering_report.response.fields.moving_energies: unknown field 'max_moving_gate + 1': a count "
-        "or size must be an earlier field of the same content"
+def test_a_count_of_a_later_field_is_one_line(tmp_path: Path) -> None:
+    """Refused in one line at the count: the device's reply value for the field that failed said a second line once
+    (`unknown response field 'moving_energies': no response carries it`)."""
+    text = SPEC.read_text("utf-8").replace("count: max_moving_gate + 1", "count: light + 1")
+    said = spec_error(text, tmp_path)
+    assert "\n" not in said and said.endswith(
+        "commands.engineering_report.response.fields.moving_energies.count: a later field 'light' in 'light + 1': a "
+        "count or size names earlier integer fields"
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a count is a number, `rest` or a field, not an expression: LD2410's engineering report sends N + 1 "
-    "energies per gate after N (`count: max_moving_gate + 1`)",
-)
-def test_a_count_of_one_more_than_a_field(tmp_path: Path) -> None:
-    spec = tmp_path / "counted.yaml"
-    spec.write_text(counted_spec(), "utf-8")
-    counted = generate_and_import(spec, tmp_path / "out", "ld2410_counted")
-    assert counted is not None
+def test_a_count_of_one_more_than_a_field(ld: ModuleType) -> None:
+    """`count: max_moving_gate + 1`: N stays in the message; decode reads N + 1 energies (the datasheet's report, N
+    = 8), encode refuses a list of another length before writing a byte, naming the count expected; construct's
+    struct reads the same; the stream parser finds frames of several N."""
+    message = ld.decode(TRACE, ld.Direction.RESPONSE)
+    assert message.max_moving_gate == 8 and list(message.moving_energies) == [60, 34, 5, 3, 3, 4, 3, 6, 5]
+    assert ld.encode(message) == TRACE
+    fields = {**message.to_fields(), "max_moving_gate": 2, "moving_energies": [1, 2, 3]}
+    fewer = ld.encode(type(message).from_fields(fields))
+    assert len(fewer) == len(TRACE) - 6 and ld.decode(fewer, ld.Direction.RESPONSE).moving_energies == (1, 2, 3)
+    with pytest.raises(EncodeError, match=r"moving_energies needs max_moving_gate \+ 1 = 3 items, got 4$"):
+        ld.encode(type(message).from_fields({**fields, "moving_energies": [1, 2, 3, 4]}))
+    with pytest.raises(DecodeError, match="moving_energies needs 256 bytes, 20 left$"):  # N = 255
+        ld.decode(TRACE[:17] + b"\xff" + TRACE[18:], ld.Direction.RESPONSE)
+    structs = importlib.import_module("hlk_ld2410.structs")
+    assert list(structs.EngineeringReportResponseContent.parse(fewer[8:-6]).moving_energies) == [1, 2, 3]
+    parser = ld.StreamParser(ld.Direction.RESPONSE)
+    assert parser.feed(b"\xf4" + fewer + TRACE + fewer[:5]) == [ld.decode(fewer, ld.Direction.RESPONSE), message]

@@ -1199,6 +1199,7 @@ end
 
 local function size_of(f, scope, rest)
   if type(f.size) == "number" then return f.size end
+  if type(f.size) == "function" then return counted(f, f.size, scope) end
   if f.size == "rest" then return rest end
   local value = scope[f.size]
   if value == nil then error(f.name .. ": its size field " .. f.size .. " is not known", 0) end
@@ -1251,6 +1252,8 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     local count, size
     if type(f.count) == "number" then
       count = f.count
+    elseif type(f.count) == "function" then
+      count = counted(f, f.count, scope)
     elseif f.count and f.count ~= "rest" then
       count = scope[f.count]
     elseif f.size then
@@ -1308,7 +1311,9 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     return pos + size
   elseif kind == "group" then
     local count = f.count
-    if type(count) == "string" and count ~= "rest" then
+    if type(count) == "function" then
+      count = counted(f, count, scope)
+    elseif type(count) == "string" and count ~= "rest" then
       count = scope[count]
     end
     local start = pos

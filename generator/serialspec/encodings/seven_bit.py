@@ -47,7 +47,7 @@ TEXT_NOTE = ", 14-bit characters as two 7-bit bytes each, low first"
 TEXT_MAXIMUM = 0x3FFF
 
 
-def text_problem(size: int | str | None, padded: bool) -> str:
+def text_problem(size: object, padded: bool) -> str:
     """Why a string of this size cannot take the encoding ("" when it can)."""
     if size is None:
         return "encoding seven_bit on text needs `size: rest` or a number of bytes, not a NUL-terminated cstring"

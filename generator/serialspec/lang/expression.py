@@ -180,6 +180,21 @@ def names(expr: Expr) -> Iterator[str]:
             yield from names(arg)
 
 
+def nodes(expr: Expr) -> list[Expr]:
+    """Every node of an expression tree."""
+    found: list[Expr] = [expr]
+    if isinstance(expr, BinOp):
+        found += nodes(expr.left) + nodes(expr.right)
+    elif isinstance(expr, Ceil):
+        found += nodes(expr.numerator) + nodes(expr.denominator)
+    elif isinstance(expr, MinMax):
+        for arg in expr.args:
+            found += nodes(arg)
+    elif isinstance(expr, Invert):
+        found += nodes(expr.operand)
+    return found
+
+
 def with_lengths(expr: Expr, lengths: Mapping[str, int]) -> Expr:
     """The expression with `len(field)` of the fields whose length is known (a fixed array's count, fixed bytes'
     size) replaced by that number: a decoder that reads such a field in a run of fixed fields has no list of it."""

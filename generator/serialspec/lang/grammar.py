@@ -456,12 +456,20 @@ _FIELD_LONG: dict[str, Shape] = {
         (Int(), Str()),
         "bytes, string: a number, `rest` (up to the end of the content) or the name of an earlier integer field, "
         "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "
-        "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE); array: the earlier "
+        "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE), or an expression over "
+        "earlier integer fields, which stay in the message (`length - 2`: see `count`); array: the earlier "
         "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
         "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
         "mismatch, Last Line: 122` as one text); the C target and the Wireshark dissector refuse it, saying so.",
     ),
-    "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
+    "count": OneOf(
+        (Int(), Str()),
+        "array/group: a number, `rest`, the name of an earlier count field (which becomes derived: encode writes the "
+        "number of items, messages leave it out), or an expression of earlier integer fields (`max_moving_gate + 1`, "
+        "`2 * n`; the grammar of `value:`), which stay in the message: decode reads that many items and refuses a "
+        "negative count, encode refuses a list of another length.",
+        example="max_moving_gate + 1",
+    ),
     "of": Str(
         "array: the item type: a scalar type; `bit` (bools packed 8 to a byte, lowest bit first); or `uN`/`iN` for "
         "integers of N bits (1..64) packed with no gaps, e.g. u11 (CRSF/SBUS RC channels: 16 × 11 bits), with a "
@@ -542,7 +550,38 @@ _FIELD_LONG: dict[str, Shape] = {
 FIELD = OneOf(
     (
         Str("A wire type or the name of an entry in `fields:`"),
-        Obj(_FIELD_LONG, description="A field in full: its type, and its unit, range, enum... where it has them."),
+        Obj(
+            _FIELD_LONG,
+            description="A field in full: its type, and its unit, range, enum... where it has them.",
+            variants=(
+                (
+                    "A count or size given by an expression (HLK LD2410's engineering report: N + 1 energies after N; "
+                    "a payload of `length - 2` bytes)",
+                    {
+                        "max_moving_gate": {"type": "u8", "description": "N, the farthest moving gate reported."},
+                        "moving_energies": {"type": "array", "of": "u8", "count": "max_moving_gate + 1"},
+                        "length": "u8",
+                        "payload": {"type": "bytes", "size": "length - 2"},
+                    },
+                    "An array's or group's `count`, a bytes or string field's `size`, may be an expression of the "
+                    "`value:` grammar over earlier integer fields of the same content (plain ones: not constant, "
+                    "derived, scaled, flags or bit fields; no `len()`). Unlike a count given by a field's name, "
+                    "which becomes derived (encode writes the list's length, messages leave it out), the fields an "
+                    "expression names stay in the message as ordinary fields: here `max_moving_gate` is a member, and "
+                    "decode reads `max_moving_gate + 1` energies. A frame whose count works out negative is refused "
+                    "in one line (`moving_energies has max_moving_gate + 1 = -1 items: a count cannot be negative`), "
+                    "as one whose count asks for more bytes than it holds. Encode refuses a list, group, bytes or "
+                    "text of another length before writing a byte, naming the field and the count expected "
+                    "(`moving_energies needs max_moving_gate + 1 = 9 items, got 8`): one rule, also for `n + 1`, "
+                    "encode never derives the fields. The expression's values for any wire values of its fields "
+                    "keep the expression limits and cannot all be negative; one that may divide by 0 or shift by a "
+                    "field is refused. A frame with no length element, trailer or stuffing is sized by a count "
+                    "`k * field + m` (k >= 1, m >= 0) of fixed-size items; another expression there is refused in one "
+                    "line. The C computes it in int64_t (docs/c.md); the Wireshark dissector refuses a count with bit "
+                    "operators (`& | << >> ~`: Lua 5.2 has none) in one line.",
+                ),
+            ),
+        ),
     ),
     "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
 )

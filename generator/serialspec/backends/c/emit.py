@@ -21,13 +21,14 @@ from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
 from serialspec.encodings import bit_run, seven_bit
-from serialspec.lang import expression
+from serialspec.lang import counts, expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
     Array,
     BitField,
     Bytes,
     Checksum,
+    Counted,
     Direction,
     Field,
     FrameLayout,
@@ -535,6 +536,25 @@ def as_size(ctx: Ctx, pad: str, value: str, out: list[str]) -> str:
     return f"(size_t)({value})"
 
 
+def count_size(
+    ctx: Ctx, pad: str, count: str | Counted, scope: Scope, out: list[str], fields: tuple[Field, ...]
+) -> str:
+    """A count or size read from a field, or worked out by its expression over earlier fields (lang/counts.py), as
+    size_t: a negative one is refused (P_E_CONTENT), one size_t cannot hold too (as_size)."""
+    if isinstance(count, str):
+        return as_size(ctx, pad, scope.lookup(count), out)
+    value = count_expression(ctx, count, scope.lookup, fields)
+    if count.low < 0:
+        out.append(f"{pad}if ({value} < 0) {{ return {ctx.P}_E_CONTENT; }} /* a negative count: {count} */")
+    return as_size(ctx, pad, value, out)
+
+
+def count_expression(ctx: Ctx, count: Counted, name: Callable[[str], str], fields: tuple[Field, ...]) -> str:
+    """A count's expression in C (int64_t) over the values `name` gives (its fields: no len(), no division by a field,
+    no value beyond int64_t: refuse_wide_counts)."""
+    return render_c(count.expr, name, c_length(fields, ""), math_of(ctx, fields))
+
+
 def get_raw(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
     """A scalar's wire bits: uint32_t, or uint64_t for 8-byte types (built with shifts, whatever the host)."""
     if wide(t):
@@ -655,7 +675,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 elif f.size == "rest":
                     out.append(f"{pad}len = n - o;")
                 elif f.size is not None:
-                    out.append(f"{pad}len = {as_size(ctx, pad, scope.lookup(f.size), out)};")
+                    out.append(f"{pad}len = {count_size(ctx, pad, f.size, scope, out, fields)};")
                 if not terminated:
                     out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
                 if isinstance(f, Text) and f.pad is not None:  # the text without the pad bytes after it
@@ -699,7 +719,9 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 decode_fields(ctx, f.fields, item_scope, body, depth + 1)
                 capacity = f"(sizeof({tgt}) / sizeof({tgt}[0]))"
                 if isinstance(f.count, int) or f.count != "rest":
-                    count = f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                    count = (
+                        f"{f.count}u" if isinstance(f.count, int) else count_size(ctx, pad, f.count, scope, out, fields)
+                    )
                     if not isinstance(f.count, int):
                         out.append(f"{pad}if ({count} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                         out.append(f"{pad}{tgt}_count = {count};")
@@ -757,7 +779,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
                 else:
                     number = (
-                        f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                        f"{f.count}u" if isinstance(f.count, int) else count_size(ctx, pad, f.count, scope, out, fields)
                     )
                     out.append(f"{pad}{tgt}_count = {number};")
                     out.append(
@@ -862,6 +884,20 @@ def refuse_wide_values(protocol: Protocol) -> None:
                         f"{collapse(expression.show(wide))} can exceed 64 bits for some values of its fields "
                         "(C computes in int64_t)"
                     )
+        refuse_wide_counts(message.fields, spans, f"{message.key} {message.direction.value}")
+
+
+def refuse_wide_counts(fields: tuple[Field, ...], spans: dict[str, expression.Bounds], where: str) -> None:
+    """A count by expression some value of which cannot fit int64_t (a u64 field's): refused, as refuse_wide_values."""
+    for f in fields:
+        count = counts.counted(f)
+        wide = None if count is None else wider_than_int64(count.expr, spans)
+        if wide is not None:
+            raise Unsupported(
+                f"{where}: {f.name}: {collapse(expression.show(wide))} can exceed 64 bits (C computes in int64_t)"
+            )
+        if isinstance(f, Group):
+            refuse_wide_counts(f.fields, value_spans(f.fields), where)
 
 
 def c_length(fields: tuple[Field, ...], target: str) -> Callable[[str], str]:
@@ -1096,6 +1132,11 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
     for f in fields:
         name = ident(f.name)
         tgt = f"{scope.target}{name}"
+        counted = counts.counted(f)
+        if counted is not None:  # as many items or bytes as its expression gives (lang/counts.py)
+            held = f"{tgt}_count" if isinstance(f, List | Group) else f"{tgt}_len"
+            value = count_expression(ctx, counted, lambda other: f"{scope.target}{ident(other)}", fields)
+            out.append(f"{pad}if ((int64_t){held} != {value}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}: {counted} */")
         match f:
             case Scalar():
                 if f.hidden:

@@ -11,7 +11,19 @@ from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.encodings import seven_bit
 from serialspec.lang import expression
-from serialspec.lang.model import Array, BitField, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
+from serialspec.lang.model import (
+    Array,
+    BitField,
+    Bytes,
+    Counted,
+    Group,
+    List,
+    Packed,
+    Scalar,
+    TableBlock,
+    TableValue,
+    Text,
+)
 
 
 def anchor(*parts: str) -> str:
@@ -127,7 +139,8 @@ class ListKind(Kind[List]):
         item = "bits (8 per byte, first in bit 0)" if f.item is None else f"{f.item.name} list"
         if f.size:
             return f"{item}, {f.size} bytes"
-        return f"{item}, up to the end" if f.count == "rest" else f"{item} × {f.count}"
+        count = f"({f.count})" if isinstance(f.count, Counted) else f.count
+        return f"{item}, up to the end" if f.count == "rest" else f"{item} × {count}"
 
     def unit(self, f: List) -> str:
         return f.unit
@@ -165,7 +178,9 @@ class GroupKind(Kind[Group]):
     model = Group
 
     def type_name(self, f: Group) -> str:
-        count = {"rest": "up to the end"}.get(str(f.count), f"× {f.count}")
+        count = {"rest": "up to the end"}.get(
+            str(f.count), f"× ({f.count})" if isinstance(f.count, Counted) else f"× {f.count}"
+        )
         return f"group {count}"
 
 

@@ -60,10 +60,11 @@ from serialspec.backends.python.optimize import (
 )
 from serialspec.backends.python.render import one_line
 from serialspec.encodings import bit_run, seven_bit
-from serialspec.lang import expression
+from serialspec.lang import counts, expression
 from serialspec.lang.model import (
     Array,
     Bytes,
+    Counted,
     Direction,
     FrameElement,
     Group,
@@ -722,7 +723,7 @@ class PackageCode:
                     body.append(TakeRest(self.local(f)))
                     body.append(Advance(to="end"))
                 else:
-                    size = self.local_named(str(f.size))
+                    size = self.count_value(f, f.size, body, where)
                     body.append(
                         Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
                     )
@@ -763,7 +764,7 @@ class PackageCode:
                 body.append(If(f"(end - o) % {f.item_size}", (split,), cursor=True))
                 body.append(Code("n = end - o", cursor=True))
             else:
-                count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+                count = self.count_value(f, f.count, body, where)
                 body.append(Code(f"n = {count} * {f.item_size}"))
                 reason = f"content too short for its count ({{{count}}} {f.name})"
                 body.append(Needs("n", f"DecodeError({where} + f': {reason}')"))
@@ -795,7 +796,7 @@ class PackageCode:
         if f.count == "rest":
             header, cursor = "while o < end", True
         else:
-            count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+            count = self.count_value(f, f.count, body, where)
             header, cursor = f"for _ in range({count})", False
         inner: Block = []
         # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
@@ -820,7 +821,7 @@ class PackageCode:
                     body.append(If(f"nb % {item}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
                 body.append(Code(f"n = nb // {item}" if item > 1 else "n = nb"))
         else:
-            body.append(Code(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}"))
+            body.append(Code(f"n = {self.count_value(f, f.count, body, where)}"))
             body.append(Code("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n")))
         body.append(Needs("nb", f"DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')"))
         most = self.most_items(f, siblings)
@@ -847,7 +848,33 @@ class PackageCode:
             return int(scalars[str(f.size)].type.maximum) // item
         if isinstance(f.count, str) and f.count in scalars:
             return int(scalars[f.count].type.maximum)
+        if isinstance(f.count, Counted):
+            return f.count.high
         return None
+
+    def count_value(self, f: SpecField, count: int | str | Counted, body: Block, where: str) -> str:
+        """Python source of a decoded count or size: a number, a count field's value, or an expression's, worked out
+        into a local and refused when negative (serialspec/lang/counts.py)."""
+        if isinstance(count, int):
+            return str(count)
+        if isinstance(count, str):
+            return self.local_named(count)
+        local = f"n_{f.name}"
+        body.append(Code(f"{local} = {counts.python_value(count, self.local_named)}"))
+        if count.low < 0:
+            reason = counts.python_reason(f, count, local)
+            body.append(If(f"{local} < 0", (Raise(f"DecodeError({where} + f': {reason}')"),)))
+        return local
+
+    def check_count(self, f: SpecField, obj: str, data: str, body: Block, where: str) -> None:
+        """Encode: a list, group, bytes or text whose count or size an expression gives has that length."""
+        count = counts.counted(f)
+        if count is None:
+            return
+        local = f"{obj}_n_{f.name}" if obj != "m" else f"n_{f.name}"
+        body.append(Code(f"{local} = {counts.python_value(count, lambda name: field_read(obj, name))}"))
+        reason = counts.python_encode_reason(f, count, local, f"len({data})")
+        body.append(If(f"len({data}) != {local}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
 
     def text_decoder(self, f: Text) -> str:
         """The runtime function making a text field's bytes its text (packing.py)."""
@@ -868,7 +895,7 @@ class PackageCode:
             body.append(Code(f"{value} = {helper}(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="end"))
             return value
-        size = f.size if isinstance(f.size, int) else self.local_named(f.size)
+        size = self.count_value(f, f.size, body, where)
         body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
         body.append(Code(f"{value} = {helper}(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
         body.append(Advance(size))
@@ -1138,6 +1165,11 @@ class PackageCode:
         else:
             self.packing.add("encode_text")
             data = f"_encode_text({expr}, {spec_key(f.name)}, {where}, {f.size is None})"
+        if isinstance(f.size, Counted):
+            local = self.local(f) if obj == "m" else f"{obj}_{f.name}"
+            body.append(Code(f"{local} = {data}"))
+            self.check_count(f, obj, local, body, where)
+            return local
         if isinstance(f.size, int):
             local = self.local(f) if obj == "m" else f"{obj}_{f.name}"
             body.append(Code(f"{local} = {data}"))
@@ -1155,6 +1187,7 @@ class PackageCode:
             case List():
                 if isinstance(f.count, int):
                     body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
+                self.check_count(f, obj, expr, body, where)
                 if f.item is None:
                     self.packing.add("pack_bits")
                     return f"_pack_bits({expr}, {spec_key(f.name)}, {where})"
@@ -1164,6 +1197,7 @@ class PackageCode:
                 return self.encode_text(f, obj, body, where)
             case Bytes():  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
                 body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
+                self.check_count(f, obj, self.local(f), body, where)
                 return self.local(f)
             case TableValue():
                 table = f"_TABLE_{f.table.name.upper()}"
@@ -1191,6 +1225,7 @@ class PackageCode:
         """A group's items, checked and packed in a loop."""
         if isinstance(f.count, int):
             body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
+        self.check_count(f, obj, expr, body, where)
         # the items are checked and packed in a loop here, not by a function called per item
         item = "item" if obj == "m" else f"{obj}_item"
         item_body: Block = []

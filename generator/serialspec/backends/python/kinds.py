@@ -8,14 +8,27 @@ fast decode/encode statements (content.py), the simulator's and client's field l
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
+from dataclasses import replace
 from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import Calls
 from serialspec.backends.python.render import one_line
-from serialspec.lang import expression
-from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, ScalarType, TableBlock, TableValue, Text
+from serialspec.lang import counts, expression
+from serialspec.lang.model import (
+    Array,
+    Bytes,
+    Counted,
+    Group,
+    List,
+    Packed,
+    Scalar,
+    ScalarType,
+    TableBlock,
+    TableValue,
+    Text,
+)
 from serialspec.lang.model import Field as SpecField
 from serialspec.lang.names import spec_key
 
@@ -96,12 +109,19 @@ def primitive(scalar: ScalarType, endian: str) -> str:
 
 def list_expr(f: List) -> str:
     """An array whose count varies, or packed bits."""
-    count = f"this.{f.count}" if isinstance(f.count, str) and f.count not in ("", "rest") else f.count
+    count: int | str | Counted = f.count
+    if isinstance(f.count, Counted):
+        count = f"({counts.construct_count(f.count)})"
+    elif isinstance(f.count, str) and f.count not in ("", "rest"):
+        count = f"this.{f.count}"
     if f.item is None:
         if f.size:
             return f"PackedBits(Bytes(this.{f.size}))"
         if f.count == "rest":
             return "PackedBits(GreedyBytes)"
+        if isinstance(f.count, Counted):
+            bits = expression.render(f.count.expr, lambda name: f"ctx.{name}")
+            return f"PackedBits(Bytes(lambda ctx: ({bits} + 7) // 8), {count})"
         return f"PackedBits(Bytes(({count} + 7) // 8), {count})"
     item = primitive(f.item, f.endian)
     if f.size:
@@ -288,6 +308,8 @@ class ListKind(Kind[List]):
         item = "False" if f.item is None else "0"
         if f.count_from:
             return f"lambda request: [{item}] * request[{f.count_from!r}]"
+        if isinstance(f.count, Counted):
+            return counts.python_blank(f.count, item)
         return f"[{item}] * {f.count}" if isinstance(f.count, int) else "[]"
 
 
@@ -303,6 +325,8 @@ class TextKind(Kind[Text]):
             return "CString('utf8')"
         if f.size == "rest":
             return "Utf8(GreedyBytes)"
+        if isinstance(f.size, Counted):
+            return f"Utf8(Bytes({counts.construct_count(f.size)}))"
         return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
 
     def fixed(self, f: Text) -> bool:
@@ -321,6 +345,8 @@ class TextKind(Kind[Text]):
     def blank(self, f: Text) -> str:
         if isinstance(f.size, int) and f.pad is None:
             return repr(" " * (f.size // 2 if f.seven_bit else f.size))
+        if isinstance(f.size, Counted):
+            return counts.python_blank(f.size, "' '")
         return "''"
 
 
@@ -332,6 +358,8 @@ class BytesKind(Kind[Bytes]):
             return "GreedyBytes"
         if isinstance(f.size, int):
             return f"Bytes({f.size})"
+        if isinstance(f.size, Counted):
+            return f"Bytes({counts.construct_count(f.size)})"
         # inside a group item the size field sits beside the bytes (BULK WRITE) or in the enclosing content (this._)
         return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
 
@@ -358,6 +386,8 @@ class BytesKind(Kind[Bytes]):
             return repr(f.default.hex(" "))
         if f.size_from:  # as many as the request asks for (zeros)
             return f"lambda request: ' '.join(['00'] * request[{f.size_from!r}])"
+        if isinstance(f.size, Counted):
+            return counts.python_blank(f.size, "'00'")
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
 
 
@@ -383,6 +413,8 @@ class GroupKind(Kind[Group]):
         item = "Struct(" + ", ".join(parts + derived_checks(f.fields)) + ")"
         if f.count == "rest":
             return f"GreedyRange({item})"
+        if isinstance(f.count, Counted):
+            return f"Array({counts.construct_count(f.count)}, {item})"
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"
         return f"Array({count}, {item})"
 
@@ -405,10 +437,23 @@ class GroupKind(Kind[Group]):
         return Calls(text, ["_mapping", "_items"], get)
 
     def blank(self, f: Group) -> str:
-        if not isinstance(f.count, int):
+        if not isinstance(f.count, int | Counted):
             return "[]"
         shown = [i for i in f.fields if not getattr(i, "hidden", False)]  # derived values are computed
-        return "[{" + ", ".join(f"{i.name!r}: {kind(i).blank(i)}" for i in shown) + f"}}] * {f.count}"
+        item = "{" + ", ".join(f"{i.name!r}: {self.item_blank(i)}" for i in shown) + "}"
+        return counts.python_blank(f.count, item) if isinstance(f.count, Counted) else f"[{item}] * {f.count}"
+
+    @staticmethod
+    def item_blank(f: SpecField) -> str:
+        """A field's blank in a blank group item, whose other fields are 0: a counted one as long as that makes it."""
+        count = counts.counted(f)
+        if count is None:
+            return kind(f).blank(f)
+        least = counts.least(count, dict.fromkeys(counts.names(count), 0))
+        if isinstance(f, List | Group):
+            return kind(f).blank(replace(f, count=least))
+        assert isinstance(f, Bytes | Text)
+        return kind(f).blank(replace(f, size=least))
 
 
 class TableValueKind(Kind[TableValue]):

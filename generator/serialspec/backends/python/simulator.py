@@ -11,7 +11,7 @@ from serialspec.backends.common.pairing import asked_commands, request_response_
 from serialspec.backends.python.kinds import kind, zero_bits
 from serialspec.backends.python.registers import map_name, register_tables
 from serialspec.backends.python.render import one_line, render
-from serialspec.lang import expression
+from serialspec.lang import counts, expression
 from serialspec.lang.model import (
     Array,
     Bytes,
@@ -372,7 +372,9 @@ def simulator_module(protocol: Protocol) -> str:
             bits = tuple((b.name, b.low, b.high) for b in element.bits)
             status = f", status=({element.name!r}, {bits!r})"
         error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap}{status})"
-    runtime = ["CommandSpec", "DeviceSpec"]
+    runtime = ["CommandSpec"]
+    runtime += ["CountedBlank"] if any(counts.counted(f) for m in protocol.messages() for f in m.fields) else []
+    runtime += ["DeviceSpec"]
     runtime += ["EntrySpec"] if entries else []
     runtime += ["ErrorSpec"] if error else []
     runtime += ["KindSpec"] if device.kinds else []

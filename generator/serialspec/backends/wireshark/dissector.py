@@ -15,6 +15,7 @@ from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import layout_codes, runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.encodings import bit_run, seven_bit
+from serialspec.lang import counts
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -22,6 +23,8 @@ from serialspec.lang.model import (
     BitField,
     Bytes,
     Checksum,
+    Count,
+    Counted,
     Direction,
     EnumDef,
     Field,
@@ -49,6 +52,9 @@ from serialspec.runtime.framing import Layout
 
 
 def emit_dissector(protocol: Protocol) -> str:
+    for message in protocol.messages():
+        if (why := counts.lua_refusal(message.fields)) is not None:
+            raise Unsupported(f"{message.key} {message.direction.value}: {why}")
     directions = {d.value: _direction(protocol, d) for d in protocol.framing.alternatives}
     used = {
         f.table.name
@@ -88,6 +94,10 @@ def emit_dissector(protocol: Protocol) -> str:
         else "",
         bit_run_lua=bit_run.LUA
         if any(isinstance(f, Scalar) and f.bit_place for m in protocol.messages() for f in _all_fields(m.fields))
+        else "",
+        # counts and sizes by expression (lang/counts.py), where a field has one
+        counted_lua=counts.LUA
+        if any(counts.counted(f) for m in protocol.messages() for f in _all_fields(m.fields))
         else "",
     )
 
@@ -317,6 +327,16 @@ def _message(protocol: Protocol, message: Message) -> dict[str, Any]:
     return result
 
 
+def _count(count: Count | None) -> int | str | Ref | None:
+    """A count or size as the engine reads it: a number, `rest`, a field's name, or a function of the fields read
+    (an expression: lang/counts.py)."""
+    if not isinstance(count, Counted):
+        return count
+    function = counts.lua_function(count)
+    assert function is not None  # refused: counts.lua_refusal
+    return Ref(function)
+
+
 def _fields(fields: tuple[Field, ...]) -> list[dict[str, Any]]:
     return [_field(item, content_bounds(fields[index + 1 :])[0]) for index, item in enumerate(fields)]
 
@@ -339,18 +359,18 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
             common.update(kind="list", type=item.item.name, big=item.endian == ">", count=item.count, unit=item.unit)
         case List():
             common.update(kind="list", type=item.item.name if item.item else "bit", big=item.endian == ">")
-            common.update(count=item.count or None, size=item.size or None, unit=item.unit)
+            common.update(count=_count(item.count) or None, size=item.size or None, unit=item.unit)
         case Packed():
             common.update(kind="packed", bits=item.bits, count=item.count, lsb_first=item.lsb_first, unit=item.unit)
             common["signed"] = item.signed
         case Text():
-            common.update(kind="text", size=item.size, pad=item.pad)
+            common.update(kind="text", size=_count(item.size), pad=item.pad)
             if item.seven_bit:  # 14-bit characters (absent: nil to the engine)
                 common["seven_bit"] = True
         case Bytes():
-            common.update(kind="bytes", size=item.size)
+            common.update(kind="bytes", size=_count(item.size))
         case Group():
-            common.update(kind="group", count=item.count, fields=_fields(item.fields))
+            common.update(kind="group", count=_count(item.count), fields=_fields(item.fields))
         case TableValue():
             common.update(kind="table_value", key=item.key, entries=Ref(f"TABLES[{_lua_name(item.table.name)}]"))
         case TableBlock():

@@ -122,6 +122,12 @@ from serialspec.lang.model.fields import (
     Common as Common,
 )
 from serialspec.lang.model.fields import (
+    Count as Count,
+)
+from serialspec.lang.model.fields import (
+    Counted as Counted,
+)
+from serialspec.lang.model.fields import (
     EnumDef as EnumDef,
 )
 from serialspec.lang.model.fields import (

@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from typing import Literal
 
-from serialspec.lang.expression import Expr
+from serialspec.lang.expression import Expr, show
 from serialspec.lang.frozen import frozen
 
 _UNIT_STEP = re.compile(r"^\s*[0-9]+(\.[0-9]+)?\s*")
@@ -143,6 +143,23 @@ class Common:
 
 
 @frozen
+class Counted:
+    """A count or size worked out from earlier integer fields that stay in the message (`count: n + 1`): decode reads
+    that many items or bytes (refusing a negative value), encode refuses a list of another length
+    (serialspec/lang/counts.py)."""
+
+    expr: Expr
+    low: int  # the least and greatest values it takes for any wire values of its fields
+    high: int
+
+    def __str__(self) -> str:
+        return show(self.expr)
+
+
+Count = int | str | Counted  # a number, "rest", the name of a count field (derived), or an expression
+
+
+@frozen
 class Scalar(Common):
     type: ScalarType
     endian: Literal["<", ">"]
@@ -201,7 +218,7 @@ class List(Common):
 
     item: ScalarType | None
     endian: Literal["<", ">"]
-    count: int | str
+    count: Count
     size: str
     unit: str
     minimum: float
@@ -245,7 +262,7 @@ class Text(Common):
     `pad`: a fixed-size text shorter than its size is sent followed by this byte (NUL-padded names), and read
     without the trailing pad bytes; None: the text must fill its size exactly."""
 
-    size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+    size: Count | None  # a number, "rest", a field name, an expression, or None for NUL-terminated
     pad: int | None = None
     seven_bit: bool = False  # `encoding: seven_bit`: 14-bit characters, two 7-bit bytes each (encodings/seven_bit.py)
 
@@ -256,7 +273,7 @@ class Text(Common):
 
 @frozen
 class Bytes(Common):
-    size: int | str  # a number, "rest", or the name of a field holding it
+    size: Count  # a number, "rest", the name of a field holding it, or an expression
     table: Table | None = None  # when the bytes are a run of registers of this table
     start: str = ""  # the field holding the first register's key: a field of this content, or of the request
     start_in_request: bool = False  # `start: request.<field>`: the field is the request's (the resolver checked it)
@@ -267,7 +284,7 @@ class Bytes(Common):
 @frozen
 class Group(Common):
     class_name: str
-    count: int | str  # a number, "rest", or the name of a count field
+    count: Count  # a number, "rest", the name of a count field, or an expression
     fields: tuple[Field, ...]
     item_size: int | None  # None when an item holds bytes sized by another field
 

@@ -4,7 +4,19 @@ from __future__ import annotations
 
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
-from serialspec.lang.model.fields import Array, Bytes, Field, Group, List, Packed, Scalar, TableBlock, TableValue, Text
+from serialspec.lang.model.fields import (
+    Array,
+    Bytes,
+    Counted,
+    Field,
+    Group,
+    List,
+    Packed,
+    Scalar,
+    TableBlock,
+    TableValue,
+    Text,
+)
 
 
 def fixed_size(field: Field) -> int | None:
@@ -50,7 +62,14 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
             low += size
             high = None if high is None else high + size
             continue
-        if isinstance(item, TableValue):
+        if isinstance(item, List | Group | Bytes | Text) and isinstance(c := counted_by(item), Counted):
+            if isinstance(item, List):
+                high = None if high is None else high + item.byte_size(c.high)
+            elif isinstance(item, Group):
+                high = None if high is None or item.item_size is None else high + c.high * item.item_size
+            else:
+                high = None if high is None else high + c.high
+        elif isinstance(item, TableValue):
             sizes = [e.type.size for e in item.table.entries if not e.reserved]
             low += min(sizes)
             high = None if high is None else high + max(sizes)
@@ -72,6 +91,45 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
         else:
             high = None
     return low, high
+
+
+def counted_by(item: List | Group | Bytes | Text) -> int | str | Counted | None:
+    """What gives the number of items (lists, groups) or bytes (bytes, text) of a field."""
+    return item.count if isinstance(item, List | Group) else item.size
+
+
+def linear(count: Counted) -> tuple[str, int, int] | None:
+    """(field, times, plus) when the count is `times * field + plus` with times >= 1 and plus >= 0 (`n + 1`, `2 * n`),
+    the forms a stream parser sizes a frame by; else None."""
+    expr = count.expr
+    plus = 0
+    if isinstance(expr, expression.BinOp) and expr.op == "+":
+        const, rest = (expr.left, expr.right) if isinstance(expr.left, expression.Const) else (expr.right, expr.left)
+        if not isinstance(const, expression.Const) or const.value < 0:
+            return None
+        plus, expr = const.value, rest
+    times = 1
+    if isinstance(expr, expression.BinOp) and expr.op == "*":
+        const, rest = (expr.left, expr.right) if isinstance(expr.left, expression.Const) else (expr.right, expr.left)
+        if not isinstance(const, expression.Const) or const.value < 1:
+            return None
+        times, expr = const.value, rest
+    return (expr.name, times, plus) if isinstance(expr, expression.Name) else None
+
+
+def counted_term(item: List | Group | Bytes | Text) -> tuple[str, int, int] | None:
+    """A field counted by an expression, as a stream parser sizes it: (field, bytes per unit of it, bytes more), for
+    `k * n + m` items of a fixed size (`n + 1` u16s: 2 per n, 2 more); None for another expression or items of
+    varying size (or bits)."""
+    count = counted_by(item)
+    assert isinstance(count, Counted)
+    found = linear(count)
+    unit = 1 if isinstance(item, Bytes | Text) else item.item_size if isinstance(item, Group) else None
+    if isinstance(item, List) and item.item is not None:
+        unit = item.item.size
+    if found is None or unit is None:
+        return None
+    return found[0], found[1] * unit, found[2] * unit
 
 
 def byte_size_expression(item: List) -> Expr | None:
@@ -103,7 +161,13 @@ def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, st
         offset = None
         sizer: str = ""
         factor = 1
-        if isinstance(item, List):
+        if isinstance(item, List | Group | Bytes | Text) and isinstance(counted_by(item), Counted):
+            term = counted_term(item)
+            if term is None:
+                return None
+            sizer, factor, plus = term
+            fixed += plus
+        elif isinstance(item, List):
             wanted = byte_size_expression(item)
             same = next((name for name, (_, f) in offsets.items() if wanted is not None and f.value == wanted), "")
             sizer = item.size or same

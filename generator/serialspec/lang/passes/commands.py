@@ -6,7 +6,7 @@ from dataclasses import replace
 from typing import Any, Literal
 
 from serialspec.checksums.seed import Seeded
-from serialspec.lang import expression
+from serialspec.lang import counts, expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -638,6 +638,10 @@ class Commands(FieldResolver):
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
+        if framing is not None and low != high and (why := counts.unsized(fields)):
+            layout = framing.layout_of(direction, str(value.get("layout") or ""))
+            if layout.length is None and not layout.trailer and layout.transparency is None:
+                self.error((*path, "fields", why[0], why[1]), why[2])
         padded = None
         if framing is not None and framing.layouts[direction].truncates and high != 0:
             if low != high:

@@ -7,7 +7,7 @@ from dataclasses import replace
 from typing import Any, Literal
 
 from serialspec.encodings import bit_run, seven_bit
-from serialspec.lang import expression, grammar
+from serialspec.lang import counts, expression, grammar
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     SCALARS,
@@ -15,6 +15,7 @@ from serialspec.lang.model import (
     BitField,
     BitPlace,
     Bytes,
+    Count,
     Field,
     Group,
     List,
@@ -48,6 +49,8 @@ TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count", "label")
 class FieldResolver(Pass):
     """Resolves a message's fields; the commands pass uses it for every message."""
 
+    later_names: list[str] = []  # the names after the field being resolved, in its content
+
     def check_rest(self, fields: tuple[Field, ...], path: Path) -> None:
         for field in fields[:-1]:
             takes_rest = (isinstance(field, Bytes) and field.size == "rest") or (
@@ -58,7 +61,9 @@ class FieldResolver(Pass):
 
     def fields(self, raw: dict[str, Any], path: Path, parent: list[Field] | None) -> tuple[Field, ...]:
         resolved: list[Field] = []
-        for name, item in raw.items():
+        names = list(raw)
+        for index, (name, item) in enumerate(raw.items()):
+            self.later_names = names[index + 1 :]  # to tell a later field from an unknown one (counts.resolve)
             field_path = (*path, name)
             self.name(name, field_path, "field name", RESERVED_FIELD_NAMES, keywords=True)
             if any(f.name == name for f in resolved):
@@ -109,7 +114,7 @@ class FieldResolver(Pass):
                     self.error(where, f"unknown field {name!r} in {expression.show(field.value)!r}")
                 elif name == field.name:
                     self.error(where, f"{field.name} cannot be derived from itself")
-            for node in _nodes(field.value):
+            for node in expression.nodes(field.value):
                 other = by_name.get(getattr(node, "name", ""))
                 if isinstance(node, expression.Length) and other is not None and not isinstance(other, LISTS):
                     self.error(where, f"len({node.name}): {node.name} is not a list, bytes or text")
@@ -208,6 +213,7 @@ class FieldResolver(Pass):
         return spec
 
     def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
+        later = tuple(self.later_names)
         spec = self.expand(item, path)
         kind = spec["type"]
         for text_key in TEXT_ONLY_FIELD_KEYS:
@@ -238,8 +244,7 @@ class FieldResolver(Pass):
             if isinstance(size, int) and size < 1:
                 raise self.fail((*path, "size"), f"size {size}: bytes of a fixed size hold at least one byte")
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
-            if isinstance(size, str) and size != "rest":
-                self.size_field(size, name, siblings, parent, path)
+            size = self.count_of(size, "size", name, siblings, parent, path, later)
             size_from = str(spec.get("size_from", ""))
             if size_from and (size != "rest" or not size_from.startswith("request.")):
                 self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
@@ -274,8 +279,7 @@ class FieldResolver(Pass):
                 return Text(**common, size=None, pad=None, seven_bit=False)
             if size is None:
                 raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
-            if isinstance(size, str) and size != "rest":
-                self.size_field(size, name, siblings, parent, path)
+            size = self.count_of(size, "size", name, siblings, parent, path, later)
             if text_encoding and (why := seven_bit.text_problem(size, "pad" in spec)):
                 self.error((*path, "encoding"), why)
             pad = self.pad(spec.get("pad"), size, (*path, "pad"))
@@ -289,7 +293,7 @@ class FieldResolver(Pass):
         if "bit_order" in spec:
             self.error((*path, "bit_order"), "`bit_order` goes with an array of uN or iN items (e.g. of: u11)")
         if kind == "array" and (spec.get("of") == "bit" or not isinstance(spec.get("count"), int) or "size" in spec):
-            return self.list_field(common, spec, path, endian, siblings)
+            return self.list_field(common, spec, path, endian, siblings, later)
         if kind == "array":
             item_type = self.scalar_type(spec.get("of"), (*path, "of"), for_field=True)
             count = spec.get("count")
@@ -314,8 +318,7 @@ class FieldResolver(Pass):
             if not spec["fields"]:
                 raise self.fail((*path, "fields"), "a group needs at least one field in each item")
             inner = self.fields(spec["fields"], (*path, "fields"), parent=siblings)
-            if isinstance(count, str) and count != "rest":
-                self.derive(count, ("count", name), siblings, path)
+            count = self.count_of(count, "count", name, siblings, None, path, later)
             item_size = sum_sizes(inner)
             class_name = self.class_name(camel(name, "item"), path, identity=("group", inner), scoped=True)
             return Group(**common, class_name=class_name, count=count, fields=inner, item_size=item_size)
@@ -387,7 +390,13 @@ class FieldResolver(Pass):
         )
 
     def list_field(
-        self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"], siblings: list[Field]
+        self,
+        common: dict[str, Any],
+        spec: dict[str, Any],
+        path: Path,
+        endian: Literal["<", ">"],
+        siblings: list[Field],
+        later: tuple[str, ...],
     ) -> List:
         """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
         name = common["name"]
@@ -403,8 +412,8 @@ class FieldResolver(Pass):
             raise self.fail((*path, "count"), "an array's count must be at least 1")
         if size and not isinstance(size, str) or size == "rest":
             raise self.fail((*path, "size"), "an array's `size` names the earlier field holding its size in bytes")
-        if isinstance(count, str) and count not in ("", "rest"):
-            self.derive(count, ("count", name), siblings, path)
+        if count:
+            count = self.count_of(count, "count", name, siblings, None, path, later)
         if size:
             self.derive(size, ("size", name), siblings, path)
         if bits:
@@ -441,7 +450,7 @@ class FieldResolver(Pass):
         except expression.ExpressionError as exc:
             raise self.fail(path, str(exc)) from None
 
-    def bytes_default(self, given: Any, size: int | str, path: Path) -> bytes | None:
+    def bytes_default(self, given: Any, size: Count, path: Path) -> bytes | None:
         """A bytes field's `default`: hex text of exactly its fixed size."""
         if given is None:
             return None
@@ -576,6 +585,32 @@ class FieldResolver(Pass):
                 return
         raise self.fail(path, f"unknown field {name!r}: a count or size must be an earlier field of the same content")
 
+    def count_of(
+        self,
+        value: Any,
+        key: str,
+        name: str,
+        siblings: list[Field],
+        parent: list[Field] | None,
+        path: Path,
+        later: tuple[str, ...],
+    ) -> Count:
+        """A count or size as given: a number or `rest` as it is; a field's name, that field made derived (encode
+        writes the length); an expression over earlier fields, which stay in the message (serialspec/lang/counts.py)."""
+        if not isinstance(value, str) or value == "rest":
+            return value  # type: ignore[no-any-return]
+        try:
+            parsed = counts.parse(value)
+            if isinstance(parsed, str):
+                if key == "size":
+                    self.size_field(parsed, name, siblings, parent, path)
+                else:
+                    self.derive(parsed, ("count", name), siblings, path)
+                return parsed
+            return counts.resolve(parsed, siblings, later)
+        except counts.CountError as exc:
+            raise self.fail((*path, key), str(exc)) from None
+
     def size_field(self, size: str, name: str, siblings: list[Field], parent: list[Field] | None, path: Path) -> None:
         """Bytes sized by a field: inside a group, a field before the group sets the size of every item."""
         if parent is not None and any(f.name == size for f in parent):
@@ -596,21 +631,6 @@ def field_type(name: str) -> ScalarType:
 LISTS = (Array, Packed, List, Bytes, Text, Group)
 _PACKED = re.compile(r"^[ui][0-9]{1,3}$")  # `of: u11`: packed integers (u8, u16, ... are byte-aligned arrays)
 _BYTE_ALIGNED = ("u8", "i8", "u16", "i16", "u32", "i32", "u64", "i64")
-
-
-def _nodes(expr: expression.Expr) -> list[expression.Expr]:
-    """Every node of an expression tree."""
-    found: list[expression.Expr] = [expr]
-    if isinstance(expr, expression.BinOp):
-        found += _nodes(expr.left) + _nodes(expr.right)
-    elif isinstance(expr, expression.Ceil):
-        found += _nodes(expr.numerator) + _nodes(expr.denominator)
-    elif isinstance(expr, expression.MinMax):
-        for arg in expr.args:
-            found += _nodes(arg)
-    elif isinstance(expr, expression.Invert):
-        found += _nodes(expr.operand)
-    return found
 
 
 def _cycle(name: str, fields: dict[str, Field], trail: list[str]) -> list[str]:

@@ -37,6 +37,7 @@ pseudo-terminal) and is the same for every protocol:
 
 from serialspec.runtime.device.engine import (
     CommandSpec,
+    CountedBlank,
     DeviceSpec,
     Engine,
     EntrySpec,
@@ -55,6 +56,7 @@ from serialspec.runtime.device.server import Simulator
 __all__ = [
     "FAULTS",
     "CommandSpec",
+    "CountedBlank",
     "DeviceSpec",
     "Engine",
     "EntrySpec",

@@ -22,6 +22,24 @@ LOG = logging.getLogger("serialspec.sim")
 
 
 @dataclass(frozen=True)
+class CountedBlank:
+    """The blank of a list, group, bytes or text whose count an expression of earlier fields gives (`count: n + 1`,
+    lang/counts.py): as many blank items as the reply's values so far make it (none for a negative count), so that
+    the reply the device sends is consistent."""
+
+    count: Callable[[dict[str, Any]], int]
+    item: Any  # one item's blank: a number, a group item's values, "00" (bytes, as hex) or " " (text)
+
+    def fill(self, values: dict[str, Any]) -> Any:
+        n = max(self.count(values), 0)
+        if self.item == "00":
+            return " ".join(["00"] * n)
+        if self.item == " ":
+            return " " * n
+        return [self.item] * n
+
+
+@dataclass(frozen=True)
 class EntrySpec:
     """One memory entry (table row)."""
 
@@ -783,7 +801,10 @@ class Engine(FaultInjection):
                 values[name] = device.get(name)  # the device's own value, never the request's
             else:
                 blank = command.blanks.get(name, 0)
-                values[name] = blank(given) if callable(blank) else blank
+                if isinstance(blank, CountedBlank):
+                    values[name] = blank.fill(values)
+                else:
+                    values[name] = blank(given) if callable(blank) else blank
         for name, layout in command.bit_fields.items():
             if name in values:
                 values[name] = unpacked(layout, values[name])

@@ -359,6 +359,23 @@ CASES: dict[str, Case] = {
             }
         },
     ),
+    # a status whose success is not 0 (Trinamic TMCL: 100 done, 101 stored in EEPROM, below 100 an error)
+    "frame: a status with its success values (ok)": Case(
+        {"v": "u8"},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "id": {"role": "address", "type": "u8"},
+                "status": {"role": "status", "type": "u8", "ok": [100, 101], "directions": ["response"]},
+                "code": {"role": "command", "type": "u8"},
+                "length": {"role": "length", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+            }
+        },
+        device={"reply": {"status": 100}},
+    ),
     "frame: status bits, error flag": Case(
         {"v": "u8"},
         {"v": "u8"},

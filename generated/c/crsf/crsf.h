@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "7dacf366bfacf83ca574a92777ca10419bb72fca52e20fe0786048fbc4187d4f"
+#define CRSF_SPEC_SHA256 "2be740c88728b9ca4c26a93f729aa4a7f68c592dddee4ef7df325528a96c3930"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

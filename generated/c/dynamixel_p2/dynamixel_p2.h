@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "3b504b6ff1edd22f0e8a4d89e5d6c79ee60ca83b5ba6311e8dc02a059e4c5264"
+#define DYNAMIXEL_P2_SPEC_SHA256 "5bec0edc329858f44bc4fef7fe4e5f63d0ebedec71481cfc3afc3242add9d3c3"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "81399eb05369b74db6efccad3a598c95c93ea70a169d0bd85c479b983bff622f"
+#define HIWONDER_RRC_SPEC_SHA256 "403c622d7ad83fa0afd11dae059770936c0be2adb4aa43c5afdfe5a3014d3075"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

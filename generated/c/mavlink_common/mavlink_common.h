@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "194f210863aec5096b4bba4ae321d56b0eb4c17e9153bcef4b8c222701792b0e"
+#define MAVLINK_COMMON_SPEC_SHA256 "43989d056a811550b22284d3db711131e7ea2c978f077b7b5f4ccf3a8056b20b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "dc99ab541ff11db57e9f184522c6f145f58efb6c956239e0cf721362518146e6"
+#define ROBOCLAW_SPEC_SHA256 "4606c6ac180ff6c38ee0b01589c9317721da2c0eebad9992fa405eefecf1c418"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

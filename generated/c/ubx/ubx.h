@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "ed276ce432cb312cf478be09c268a705c1eae0de602f4afc3ae2e8321a8aa1fb"
+#define UBX_SPEC_SHA256 "01ccd3beec0b096fc58eef9dfc3f0a53840575f8c3ab68dfc65091d623bce560"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "1a312400544e75776d450b7df623d9106570a16191a918bb96129a07b698fe3e"
+#define VESC_SPEC_SHA256 "aa2f7486c7e7f49a92a5935a936976c6c4655126e134648ea67199455b97d108"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

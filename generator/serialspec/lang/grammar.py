@@ -1140,6 +1140,13 @@ FRAME_ELEMENT = Obj(
             default=False,
             example=True,
         ),
+        "ok": ListOf(
+            Int(),
+            "status: the values that mean the device carried out the request (default: 0, or with `bits` every bit "
+            "field 0): clients raise DeviceError for a reply whose status holds any other, naming it (Trinamic TMCL: "
+            "`ok: [100, 101]`, done and stored in EEPROM; below 100 an error). Not with `bits`.",
+            example=[100, 101],
+        ),
         "flags": Str("status (address, value): name of an entry in `flags:`."),
         "bits": bit_fields(
             "status, address or value: bit fields packed into the element (DYNAMIXEL: alert bit 7, error number "
@@ -1807,7 +1814,10 @@ DEVICE = Obj(
             Obj(
                 {
                     "type": Str(
-                        "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
+                        "The item type: `bit`, or an integer type; a signed one keeps negative values (Trinamic "
+                        "TMCL's axis parameters: `i32`), a value written wraps to the type's bits as it would on the "
+                        "wire.",
+                        choices=("bit", "u8", "u16", "u32", "i8", "i16", "i32"),
                     ),
                     "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
                     "access": Str("r: requests only read it; rw: they read and write it.", choices=("r", "rw")),

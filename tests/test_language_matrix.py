@@ -936,10 +936,11 @@ CASES["frame: one layout, code-less replies of different sizes, read as the repl
     },
 )
 # And a code-less reply whose last bytes are as many as its request asks for (the Pololu Tic's Get Variable, the
-# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`)
+# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`);
+# here one more than the field says (STM32's Read Memory sends the count minus one: `request.length + 1`)
 CASES["frame: one layout, a code-less reply sized by its request (size_from)"] = Case(
-    {"offset": "u8", "length": {"type": "u8", "range": [1, 6]}},
-    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length"}},
+    {"offset": "u8", "length": {"type": "u8", "range": [0, 5]}},
+    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length + 1"}},
     CODELESS_REPLIES,
     commands={
         "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "5bec0edc329858f44bc4fef7fe4e5f63d0ebedec71481cfc3afc3242add9d3c3"
+#define DYNAMIXEL_P2_SPEC_SHA256 "2a99b5c760debcb3db75decf97fbd79c7a1973234f6206b9ceeedc3ad63e7bac"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "e27d19f6ceb7a4bc22089c7f3af03628876adaf4d7d8a3eb2a9dfb4766c705c7"
+#define FEETECH_SMS_SPEC_SHA256 "484eecb60ef059d7ee461411109a35d66fff21ad0bd7c6ae52d3fdbd123ac7b8"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

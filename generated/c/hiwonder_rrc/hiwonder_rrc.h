@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "403c622d7ad83fa0afd11dae059770936c0be2adb4aa43c5afdfe5a3014d3075"
+#define HIWONDER_RRC_SPEC_SHA256 "9a0b3f90315f401bce27f8ca43786747dcab45497c2b487874e760466f01fb12"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "01ccd3beec0b096fc58eef9dfc3f0a53840575f8c3ab68dfc65091d623bce560"
+#define UBX_SPEC_SHA256 "bba7a30dfa13eb406fc35c128e363484da5e8c268a0529f557e05b6fb17a2d05"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

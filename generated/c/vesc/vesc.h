@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "aa2f7486c7e7f49a92a5935a936976c6c4655126e134648ea67199455b97d108"
+#define VESC_SPEC_SHA256 "dcf7c1373db9d5d0cc2d7ae8ba8f4437d768019c4f4eb29e32a4f218f0d1cdf2"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

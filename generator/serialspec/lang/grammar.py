@@ -504,7 +504,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
     "size_from": Str(
-        "bytes of a response, size `rest`: the request field giving its size (request.<field>). Where the frame "
+        "bytes of a response, size `rest`: the request field giving its size (request.<field>), or the bytes that "
+        "field plus (or minus) a number gives (`request.count + 1`: STM32's Read Memory sends the number of bytes "
+        "minus one; not for a run of registers). Where the frame "
         "carries no length (a raw read: the Pololu Tic's Get Variable answers `length` bytes alone), the stream "
         "parser sizes the reply awaited by that field of its request (the client's), and decode and encode with the "
         "request refuse a reply of another size (the simulator then answers nothing and logs why; the C target "

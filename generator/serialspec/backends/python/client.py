@@ -69,8 +69,10 @@ def address_of(protocol: Protocol, request: Message | None = None) -> tuple[str,
 
 
 def value_fields(protocol: Protocol, message: Message) -> list[Field]:
-    """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them."""
-    layout = protocol.framing.layouts[message.direction]
+    """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them: those
+    of the layout its frames travel in (layouts chosen by command may carry different ones: STM32's Read Memory
+    address)."""
+    layout = protocol.layout(message)
     frame = [element_scalar(e) for e in layout.value_elements if e.type is not None]
     return [*frame, *(f for f in message.fields if not (isinstance(f, Scalar) and f.hidden))]
 

@@ -376,6 +376,30 @@ CASES: dict[str, Case] = {
         },
         device={"reply": {"status": 100}},
     ),
+    # sub-commands picked by a selector of two bytes inside the content, at another offset in each direction (HCI's
+    # Command Complete: its u16 opcode after num_packets); the Python decoder once read its first byte alone
+    "sub-commands by a u16 selector": Case(
+        {"v": "u8"},
+        {"v": "u8"},
+        commands={
+            "op": {
+                "code": 7,
+                "selector": {"type": "u16", "name": "opcode", "offset": {"request": 0, "response": 1}},
+                "subcommands": {
+                    "reset": {
+                        "code": 0x0C03,
+                        "request": {"fields": {}},
+                        "response": {"fields": {"packets": "u8", "status": "u8"}},
+                    },
+                    "version": {
+                        "code": 0x1001,
+                        "request": {"fields": {"what": "u8"}},
+                        "response": {"fields": {"packets": "u8", "major": "u8", "minor": "u16"}},
+                    },
+                },
+            }
+        },
+    ),
     "frame: status bits, error flag": Case(
         {"v": "u8"},
         {"v": "u8"},
@@ -548,7 +572,9 @@ class Built:
 
 
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
-C_REFUSES: dict[str, str] = {}
+C_REFUSES: dict[str, str] = {
+    "sub-commands by a u16 selector": "sub-command selectors of more than one byte (command op)",
+}
 
 
 # Cases the Wireshark target refuses (backends.Unsupported), with the one line it says.

@@ -126,7 +126,7 @@ def fitted(message: Message, fields: dict[str, Any], request: Any) -> dict[str, 
     last = message.fields[-1] if message.fields else None
     if request is None or not isinstance(last, Bytes) or not last.size_from:
         return fields
-    return {**fields, last.name: " ".join(["5a"] * request.to_fields()[last.size_from])}
+    return {**fields, last.name: " ".join(["5a"] * (request.to_fields()[last.size_from] + last.size_from_adds))}
 
 
 def a_request(g: Generated, spec: Message) -> Any:

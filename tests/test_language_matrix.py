@@ -375,6 +375,47 @@ CASES: dict[str, Case] = {
             }
         },
     ),
+    # a status whose success is not 0 (Trinamic TMCL: 100 done, 101 stored in EEPROM, below 100 an error)
+    "frame: a status with its success values (ok)": Case(
+        {"v": "u8"},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "id": {"role": "address", "type": "u8"},
+                "status": {"role": "status", "type": "u8", "ok": [100, 101], "directions": ["response"]},
+                "code": {"role": "command", "type": "u8"},
+                "length": {"role": "length", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+            }
+        },
+        device={"reply": {"status": 100}},
+    ),
+    # sub-commands picked by a selector of two bytes inside the content, at another offset in each direction (HCI's
+    # Command Complete: its u16 opcode after num_packets); the Python decoder once read its first byte alone
+    "sub-commands by a u16 selector": Case(
+        {"v": "u8"},
+        {"v": "u8"},
+        commands={
+            "op": {
+                "code": 7,
+                "selector": {"type": "u16", "name": "opcode", "offset": {"request": 0, "response": 1}},
+                "subcommands": {
+                    "reset": {
+                        "code": 0x0C03,
+                        "request": {"fields": {}},
+                        "response": {"fields": {"packets": "u8", "status": "u8"}},
+                    },
+                    "version": {
+                        "code": 0x1001,
+                        "request": {"fields": {"what": "u8"}},
+                        "response": {"fields": {"packets": "u8", "major": "u8", "minor": "u16"}},
+                    },
+                },
+            }
+        },
+    ),
     "frame: status bits, error flag": Case(
         {"v": "u8"},
         {"v": "u8"},
@@ -547,7 +588,9 @@ class Built:
 
 
 # Cases the C target refuses (backends.Unsupported), with the one line it says: the C files are left out.
-C_REFUSES: dict[str, str] = {}
+C_REFUSES: dict[str, str] = {
+    "sub-commands by a u16 selector": "sub-command selectors of more than one byte (command op)",
+}
 
 
 # Cases the Wireshark target refuses (backends.Unsupported), with the one line it says.
@@ -951,10 +994,11 @@ CASES["frame: one layout, code-less replies of different sizes, read as the repl
     },
 )
 # And a code-less reply whose last bytes are as many as its request asks for (the Pololu Tic's Get Variable, the
-# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`)
+# Maestro's raw reads: `size_from`), which nothing in the frame sizes: sized by the request awaited (C: `asked`);
+# here one more than the field says (STM32's Read Memory sends the count minus one: `request.length + 1`)
 CASES["frame: one layout, a code-less reply sized by its request (size_from)"] = Case(
-    {"offset": "u8", "length": {"type": "u8", "range": [1, 6]}},
-    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length"}},
+    {"offset": "u8", "length": {"type": "u8", "range": [0, 5]}},
+    {"data": {"type": "bytes", "size": "rest", "size_from": "request.length + 1"}},
     CODELESS_REPLIES,
     commands={
         "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"default": True, "fields": {"b": "i16"}}}

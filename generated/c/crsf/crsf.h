@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "c33ad0dc73e6049023c39b3cde661b20aaef9922db1c564602ba72f1aff9ed07"
+#define CRSF_SPEC_SHA256 "8bc1c42cdd97ab6b5f3132e69524a29d549a8d062148eb874599f8ddad798147"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

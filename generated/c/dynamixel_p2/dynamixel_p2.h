@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "f692727a14399754218eb18cf9cac00198c921d8a42b1d3c49c5ff5dc0e6279f"
+#define DYNAMIXEL_P2_SPEC_SHA256 "29c04406c5673fb75fedfd3977bfbb6cfdf6c29a99fa52a33d463e7db8f593e4"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "a86cd9effa4470f1e054ada56e14cd3327d0777725fd6b1686e1d295b5d1679a"
+#define FEETECH_SMS_SPEC_SHA256 "400b3db4c27405331a9e783a394035cba73ff6c77e5358ace8de7ed18d35e81b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "d45873186d424a375d1737c1c9da8cce54df9d21ad28c91ad79ed1b54baa258b"
+#define HIWONDER_RRC_SPEC_SHA256 "b0ac52e8cd67497c4be40e37ffed7cbcc86dab3dd909edb19a5edd534d393581"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "dabb43f21d9f4492348c157ec28756ceb4382392658c474aec63885dfd30c91b"
+#define MAVLINK_COMMON_SPEC_SHA256 "2209d794a7eb419c27d23ecd8ed87ac0424a7b3e2123773422cc8897a843c1d5"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

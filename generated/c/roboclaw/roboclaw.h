@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "1e321f5dfffcf2be2f175a3be1a8a1784450893ceffa78f53d1a9906da86a355"
+#define ROBOCLAW_SPEC_SHA256 "0de8cc0063f90a41be91a52fd7b94b9f35c00ca6c94be16cbd2fe9b0b438349b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "afdd0dfd98a6b220c6a0ac46077f87d3b1569c402b67e90991a76ac3491de7f0"
+#define VESC_SPEC_SHA256 "ea4e7fac7692c5c061b1e6e047e2bb3373e60fa10d2d64a5dc2f8e71e4651eee"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -1991,11 +1991,12 @@ def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
 
 
 def _decode_motor_request(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 0:
+    if end - o < 1:
         raise DecodeError('motor request' + ": content too short for its sub-command")
-    decoder = _MOTOR_REQUEST_SUBCOMMANDS.get(buf[o + 0])
+    selected = buf[o + 0]
+    decoder = _MOTOR_REQUEST_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('motor request' + f": unknown sub-command {buf[o + 0]:#04x}")
+        raise DecodeError('motor request' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2009,11 +2010,12 @@ _MOTOR_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_pwm_servo_request(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 0:
+    if end - o < 1:
         raise DecodeError('pwm_servo request' + ": content too short for its sub-command")
-    decoder = _PWM_SERVO_REQUEST_SUBCOMMANDS.get(buf[o + 0])
+    selected = buf[o + 0]
+    decoder = _PWM_SERVO_REQUEST_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('pwm_servo request' + f": unknown sub-command {buf[o + 0]:#04x}")
+        raise DecodeError('pwm_servo request' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2027,11 +2029,12 @@ _PWM_SERVO_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_bus_servo_request(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 0:
+    if end - o < 1:
         raise DecodeError('bus_servo request' + ": content too short for its sub-command")
-    decoder = _BUS_SERVO_REQUEST_SUBCOMMANDS.get(buf[o + 0])
+    selected = buf[o + 0]
+    decoder = _BUS_SERVO_REQUEST_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('bus_servo request' + f": unknown sub-command {buf[o + 0]:#04x}")
+        raise DecodeError('bus_servo request' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2059,11 +2062,12 @@ _BUS_SERVO_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_rgb_request(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 0:
+    if end - o < 1:
         raise DecodeError('rgb request' + ": content too short for its sub-command")
-    decoder = _RGB_REQUEST_SUBCOMMANDS.get(buf[o + 0])
+    selected = buf[o + 0]
+    decoder = _RGB_REQUEST_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('rgb request' + f": unknown sub-command {buf[o + 0]:#04x}")
+        raise DecodeError('rgb request' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2073,11 +2077,12 @@ _RGB_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_pwm_servo_response(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 1:
+    if end - o < 2:
         raise DecodeError('pwm_servo response' + ": content too short for its sub-command")
-    decoder = _PWM_SERVO_RESPONSE_SUBCOMMANDS.get(buf[o + 1])
+    selected = buf[o + 1]
+    decoder = _PWM_SERVO_RESPONSE_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('pwm_servo response' + f": unknown sub-command {buf[o + 1]:#04x}")
+        raise DecodeError('pwm_servo response' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2088,11 +2093,12 @@ _PWM_SERVO_RESPONSE_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_bus_servo_response(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 1:
+    if end - o < 2:
         raise DecodeError('bus_servo response' + ": content too short for its sub-command")
-    decoder = _BUS_SERVO_RESPONSE_SUBCOMMANDS.get(buf[o + 1])
+    selected = buf[o + 1]
+    decoder = _BUS_SERVO_RESPONSE_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('bus_servo response' + f": unknown sub-command {buf[o + 1]:#04x}")
+        raise DecodeError('bus_servo response' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 
@@ -2110,11 +2116,12 @@ _BUS_SERVO_RESPONSE_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
 
 
 def _decode_system_response(buf: bytes, o: int, end: int) -> Message:
-    if end - o <= 0:
+    if end - o < 1:
         raise DecodeError('system response' + ": content too short for its sub-command")
-    decoder = _SYSTEM_RESPONSE_SUBCOMMANDS.get(buf[o + 0])
+    selected = buf[o + 0]
+    decoder = _SYSTEM_RESPONSE_SUBCOMMANDS.get(selected)
     if decoder is None:
-        raise DecodeError('system response' + f": unknown sub-command {buf[o + 0]:#04x}")
+        raise DecodeError('system response' + f": unknown sub-command {selected:#04x}")
     return decoder(buf, o, end)
 
 

@@ -512,7 +512,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
     "size_from": Str(
-        "bytes of a response, size `rest`: the request field giving its size (request.<field>). Where the frame "
+        "bytes of a response, size `rest`: the request field giving its size (request.<field>), or the bytes that "
+        "field plus (or minus) a number gives (`request.count + 1`: STM32's Read Memory sends the number of bytes "
+        "minus one; not for a run of registers). Where the frame "
         "carries no length (a raw read: the Pololu Tic's Get Variable answers `length` bytes alone), the stream "
         "parser sizes the reply awaited by that field of its request (the client's), and decode and encode with the "
         "request refuse a reply of another size (the simulator then answers nothing and logs why; the C target "
@@ -1178,6 +1180,13 @@ FRAME_ELEMENT = Obj(
             "replies by it.",
             default=False,
             example=True,
+        ),
+        "ok": ListOf(
+            Int(),
+            "status: the values that mean the device carried out the request (default: 0, or with `bits` every bit "
+            "field 0): clients raise DeviceError for a reply whose status holds any other, naming it (Trinamic TMCL: "
+            "`ok: [100, 101]`, done and stored in EEPROM; below 100 an error). Not with `bits`.",
+            example=[100, 101],
         ),
         "flags": Str("status (address, value): name of an entry in `flags:`."),
         "bits": bit_fields(
@@ -1853,7 +1862,10 @@ DEVICE = Obj(
             Obj(
                 {
                     "type": Str(
-                        "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
+                        "The item type: `bit`, or an integer type; a signed one keeps negative values (Trinamic "
+                        "TMCL's axis parameters: `i32`), a value written wraps to the type's bits as it would on the "
+                        "wire.",
+                        choices=("bit", "u8", "u16", "u32", "i8", "i16", "i32"),
                     ),
                     "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
                     "access": Str("r: requests only read it; rw: they read and write it.", choices=("r", "rw")),

@@ -119,6 +119,7 @@ class Binding:
     parser: Callable[[], StreamParser]  # a parser for what the host receives (responses)
     match_by: tuple[str, ...]  # `command`, `subcommand` or field names, from the spec's `matching.by`
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
+    status_ok: Mapping[str, frozenset[int]] = field(default_factory=dict)  # status -> its success values, if not 0
     address: str = ""  # the request field holding the device id: a Timeout names it, also where replies do not
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
     errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
@@ -939,10 +940,17 @@ class Bus:
         return " ".join(parts)
 
     def _check_status(self, reply: Message) -> None:
-        """A reply whose status fields (the spec's frame status elements) are not all zero is a DeviceError."""
+        """A reply whose status fields (the spec's frame status elements) are not all zero (or not one of their `ok`
+        values) is a DeviceError."""
         for name in self.binding.status:
             value = getattr(reply, name, 0)
-            if isinstance(value, Record):  # a status made of bit fields: an error when any is non-zero
+            ok = self.binding.status_ok.get(name)
+            if ok is not None:
+                if int(value) not in ok:
+                    raise DeviceError(
+                        f"{reply.COMMAND}: the device reports {self.binding.describe_status(name, int(value))}", reply
+                    )
+            elif isinstance(value, Record):  # a status made of bit fields: an error when any is non-zero
                 parts = {field: getattr(value, field) for field in value.__match_args__}
                 if any(parts.values()):
                     text = ", ".join(f"{k} = {v.name.lower() if isinstance(v, Enum) else v}" for k, v in parts.items())

@@ -32,7 +32,7 @@ def asked_replies(protocol: Protocol) -> list[tuple[Message, Message, str, int]]
         request = next(
             m for m in protocol.messages() if m.direction == Direction.REQUEST and reply_of(protocol, m) is reply
         )
-        fixed = sum(fixed_size(f) or 0 for f in before)
+        fixed = sum(fixed_size(f) or 0 for f in before) + last.size_from_adds  # `request.count + 1`
         found.append((reply, request, last.size_from, fixed))
     return found
 

@@ -69,8 +69,10 @@ def address_of(protocol: Protocol, request: Message | None = None) -> tuple[str,
 
 
 def value_fields(protocol: Protocol, message: Message) -> list[Field]:
-    """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them."""
-    layout = protocol.framing.layouts[message.direction]
+    """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them: those
+    of the layout its frames travel in (layouts chosen by command may carry different ones: STM32's Read Memory
+    address)."""
+    layout = protocol.layout(message)
     frame = [element_scalar(e) for e in layout.value_elements if e.type is not None]
     return [*frame, *(f for f in message.fields if not (isinstance(f, Scalar) and f.hidden))]
 
@@ -481,12 +483,15 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         if response is not None:
             imports.add(response.class_name)
             # a reply field named like one of the call's arguments repeats it and is left out of what the method
-            # returns, unless the device reports it from elsewhere (`reports`: a level the device may have changed)
-            reported = set(behaviour.reports) if behaviour else set()
+            # returns, unless the device reports it from elsewhere (`reports`: a level the device may have changed;
+            # `reads`: what it keeps, TMCL's Get Axis Parameter `value` beside the request's unused `value`)
+            reported = {*behaviour.reports, *behaviour.reads, *behaviour.space_reads} if behaviour else set()
             echoes = {f.name for f in fields} - reported | {f.name for f in statuses}
             echoes |= unused_fields(protocol, request, response)
             echoes |= {response.request_code} - {""}  # the request's own code, matched by the bus
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
+            # frame-level values (a reply address) only where the content has nothing left to return
+            rest = [f for f in rest if f in response.fields] or rest
             # the spec's `echoes` say the reply repeats them: checked against the arguments (a derived count, which
             # the method returns, is not one)
             echoed = [name for name in behaviour.echoes if name in {f.name for f in fields}] if behaviour else []
@@ -674,6 +679,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         address=repr(address),
         broadcast=repr(broadcast),
         status=repr(tuple(e.name for e in status_elements(protocol))),
+        status_ok=repr({e.name: frozenset(e.ok) for e in status_elements(protocol) if e.ok}),
         methods=methods,
         carriers=carriers,
         askers=[m["asks"] for m in askers],

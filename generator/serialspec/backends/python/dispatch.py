@@ -45,8 +45,11 @@ def value_arguments(layout: FrameLayout) -> dict[str, str]:
     }
 
 
-def direction_entry(command: Command, direction: Direction) -> tuple[str, int, int | None, dict[str, Any]] | None:
-    """The decoder a command code dispatches to in one direction, the content size bounds, any sub-dispatch."""
+def direction_entry(
+    command: Command, direction: Direction, byte_order: str = "little"
+) -> tuple[str, int, int | None, dict[str, Any]] | None:
+    """The decoder a command code dispatches to in one direction, the content size bounds, any sub-dispatch (its
+    selector read as the integer of its type, in the protocol's `byte_order`: HCI's u16 opcode)."""
     if command.selector is None:
         message = command.request if direction == Direction.REQUEST else command.response
         if message is None:
@@ -66,9 +69,18 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
         for s in command.subcommands
         if (m := s.request if direction == Direction.REQUEST else s.response) is not None
     ]
+    offset, selector = command.selector.offsets[direction], command.selector.type
+    read = (
+        f"buf[o + {offset}]"
+        if selector.size == 1 and not selector.signed
+        else f"int.from_bytes(buf[o + {offset} : o + {offset + selector.size}], {byte_order!r}"
+        + (", signed=True)" if selector.signed else ")")
+    )
     sub = {
         "name": name,
-        "offset": command.selector.offsets[direction],
+        "offset": offset,
+        "end": offset + selector.size,
+        "read": read,
         "table": table,
         "entries": entries,
         "where": f"{command.name} {direction.value}",
@@ -154,16 +166,16 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
     by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
     codes: dict[str, int | None] = {}  # each key's code (None: frames without one)
     for command in protocol.commands:
-        entry = direction_entry(command, direction)
+        entry = direction_entry(command, direction, protocol.byte_order)
         if entry is None:
             continue
         target, low, high, sub_dispatch = entry
-        if sub_dispatch:
-            found.dispatchers.append(sub_dispatch | value_arguments(layout))
-        message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
         # its own layout, where layouts are chosen by command (`layout:`): frames of a layout without a command
-        # element carry no code
+        # element carry no code, and it carries its own frame values
         own = protocol.layout(next(m for m in command.messages() if m.direction == direction))
+        if sub_dispatch:
+            found.dispatchers.append(sub_dispatch | value_arguments(own))
+        message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
         key = code_key(command, own)
         by_code.setdefault(key, []).append((message, target, low, high))
         codes[key] = command.wire_code(direction) if own.has_command else None

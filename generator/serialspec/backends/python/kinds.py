@@ -385,7 +385,7 @@ class BytesKind(Kind[Bytes]):
         if f.default is not None:
             return repr(f.default.hex(" "))
         if f.size_from:  # as many as the request asks for (zeros)
-            return f"lambda request: ' '.join(['00'] * request[{f.size_from!r}])"
+            return f"lambda request: ' '.join(['00'] * (request[{f.size_from!r}] + {f.size_from_adds}))"
         if isinstance(f.size, Counted):
             return counts.python_blank(f.size, "'00'")
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"

@@ -159,6 +159,8 @@ def run_spec(run: SpaceAccess) -> str:
     if run.value is not None:
         body = expression.render(run.value, lambda n: "current" if n == "current" else f"fields[{n!r}]")
         args.append(f"value=lambda current, fields: {body}")
+    if run.single:
+        args.append("single=True")
     return f"RunSpec({', '.join(args)})"
 
 
@@ -352,7 +354,7 @@ def simulator_module(protocol: Protocol) -> str:
         commands.append({"key": request.key, "args": args})
     spaces = [
         f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "
-        f"{s.access!r}),"
+        f"{s.access!r}{'' if s.item is None or not s.item.signed else f', minimum={int(s.item.minimum)}'}),"
         for s in device.spaces
     ]
     error, unwraps = "", False

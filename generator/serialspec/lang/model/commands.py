@@ -99,6 +99,8 @@ def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
             continue
         if not response.unsolicited:
             index.setdefault(response.answers or response.key, response)
+            if response.answers and response.key not in requests:  # and an `answered_by` naming it, as it says
+                index.setdefault(response.key, response)
         elif response.answers:
             index.setdefault(response.answers, response)
         elif response.key not in requests:

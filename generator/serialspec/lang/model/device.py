@@ -27,7 +27,7 @@ class Motion:
 
 @frozen
 class Space:
-    """A data space a device keeps: `size` items addressed 0..size-1, bits or unsigned integers, all 0 at first."""
+    """A data space a device keeps: `size` items addressed 0..size-1, bits or integers, all 0 at first."""
 
     name: str
     item: ScalarType | None  # None: bits
@@ -44,6 +44,7 @@ class SpaceAccess:
     start: str
     count: str = ""
     value: Expr | None = None  # writes: what is stored, from the request's fields and `current`
+    single: bool = False  # reads into a response field that is one number (no array): the item itself
 
 
 @frozen

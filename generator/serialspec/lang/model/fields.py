@@ -278,6 +278,7 @@ class Bytes(Common):
     start: str = ""  # the field holding the first register's key: a field of this content, or of the request
     start_in_request: bool = False  # `start: request.<field>`: the field is the request's (the resolver checked it)
     size_from: str = ""  # a response's `rest` bytes: the request field giving their number (`request.<field>`)
+    size_from_adds: int = 0  # ... plus this many (`request.count + 1`: STM32 Read Memory's count minus one)
     default: bytes | None = None  # bytes of a fixed size: the value a message built without them has
 
 

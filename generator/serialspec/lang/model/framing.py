@@ -51,6 +51,7 @@ class FrameElement:
     adds: int = 0  # length: added to the counted size
     checksum: Checksum | None = None  # checksum: what it is and what it covers
     sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
+    ok: tuple[int, ...] = ()  # status: the values that mean success (none given: 0, every bit field 0)
     truncate: bool = False  # content: trailing zero bytes dropped on encode, padded back on decode (MAVLink v2)
     present_if: tuple[str, int] = ("", 0)  # optional: (flag element, mask): sent when flag & mask (MAVLink signature)
     # command: the code this layout's frames carry, as an expression of the command's `code` (`code & 0x7F`), as

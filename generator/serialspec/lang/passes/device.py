@@ -130,7 +130,9 @@ class DevicePass(Pass):
             request_set = {f.name for f in (*request.fields, *item_fields)} | broken
             request_names: Container[str] = EVERYTHING if each and group is None else request_set
             response_names = ({f.name for f in response.fields} if response else set()) | broken
-            space_reads = self.space_runs(item.get("reads"), response_names, request, spaces, (*item_path, "reads"))
+            space_reads = self.space_runs(
+                item.get("reads"), response_names, request, spaces, (*item_path, "reads"), response
+            )
             space_writes = self.space_runs(item.get("writes"), request_set, request, spaces, (*item_path, "writes"))
             for name in item.get("reads") or () if not space_reads else ():
                 if name not in response_names:
@@ -688,9 +690,16 @@ class DevicePass(Pass):
         return DeviceErrors(**reasons)
 
     def space_runs(
-        self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path
+        self,
+        value: Any,
+        names: set[str],
+        request: Message,
+        spaces: dict[str, Space],
+        path: Path,
+        response: Message | None = None,
     ) -> dict[str, SpaceAccess]:
-        """`reads:`/`writes:` given as field -> run of a data space (a list of names is memory, handled above)."""
+        """`reads:`/`writes:` given as field -> run of a data space (a list of names is memory, handled above). A read
+        into a single number (a response field that is no array) is one item, without `count`."""
         if not isinstance(value, dict):
             return {}
         request_names = {f.name for f in request.fields}
@@ -714,7 +723,13 @@ class DevicePass(Pass):
                     for used in expression.names(stored):
                         if used != "current" and used not in request_names:
                             self.error((*item_path, "value"), f"unknown request field {used!r}")
-            runs[str(name)] = SpaceAccess(str(item["space"]), str(item["start"]), str(item.get("count", "")), stored)
+            read_into = next((f for f in response.fields if f.name == name), None) if response else None
+            single = isinstance(read_into, Scalar)
+            if single and item.get("count"):
+                self.error((*item_path, "count"), f"{name} is one number, not an array: a run read into it is one item")
+            runs[str(name)] = SpaceAccess(
+                str(item["space"]), str(item["start"]), str(item.get("count", "")), stored, single
+            )
         return runs
 
     def keeps(

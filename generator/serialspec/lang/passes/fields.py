@@ -245,9 +245,11 @@ class FieldResolver(Pass):
                 raise self.fail((*path, "size"), f"size {size}: bytes of a fixed size hold at least one byte")
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
             size = self.count_of(size, "size", name, siblings, parent, path, later)
-            size_from = str(spec.get("size_from", ""))
-            if size_from and (size != "rest" or not size_from.startswith("request.")):
+            size_from, size_from_adds = self.size_from(spec.get("size_from"), (*path, "size_from"))
+            if size_from and size != "rest":
                 self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
+            if size_from_adds and table is not None:
+                self.error((*path, "size_from"), "a run of registers is as long as the request's field: no `+ N`")
             start = str(spec.get("start", ""))
             if start and table is None:
                 self.error((*path, "start"), "`start` goes with `table:` (the bytes are a run of its registers)")
@@ -265,7 +267,8 @@ class FieldResolver(Pass):
                 table=table,
                 start=start.removeprefix("request."),
                 start_in_request=start.startswith("request."),
-                size_from=size_from.removeprefix("request."),
+                size_from=size_from,
+                size_from_adds=size_from_adds,
             )
         if kind in ("string", "cstring"):
             size = spec.get("size")
@@ -610,6 +613,20 @@ class FieldResolver(Pass):
             return counts.resolve(parsed, siblings, later)
         except counts.CountError as exc:
             raise self.fail((*path, key), str(exc)) from None
+
+    def size_from(self, value: Any, path: Path) -> tuple[str, int]:
+        """`size_from: request.<field>`, or `request.<field> + N` (`- N`): the request field and the bytes added."""
+        if value is None:
+            return "", 0
+        match = re.fullmatch(r"\s*request\.([a-z_][a-z0-9_]*)\s*(?:([+-])\s*(\d+)\s*)?", str(value))
+        if match is None:
+            if not str(value).startswith("request."):
+                self.error(path, "`size_from: request.<field>` goes with `size: rest`")
+            else:
+                self.error(path, "`size_from` is `request.<field>`, or `request.<field> + N` (a count minus one)")
+            return "", 0
+        name, sign, number = match.groups()
+        return name, (int(number) if sign == "+" else -int(number)) if number else 0
 
     def size_field(self, size: str, name: str, siblings: list[Field], parent: list[Field] | None, path: Path) -> None:
         """Bytes sized by a field: inside a group, a field before the group sets the size of every item."""

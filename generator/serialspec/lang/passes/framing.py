@@ -224,11 +224,18 @@ class FramingPass(FieldResolver):
             resolved = self.scalar(common, {"type": scalar.name, "bits": item["bits"]}, path, endian)
             bits, bits_class = resolved.bits, resolved.bits_class
         checksum = self.checksum(item, name, scalar, endian, path) if role == "checksum" and scalar else None
+        ok = tuple(int(v) for v in item.get("ok") or ())
+        if ok and "bits" in item:
+            self.error((*path, "ok"), "`ok` compares the status as one number: give it without `bits`")
+        for value in ok:
+            if scalar is not None and not scalar.minimum <= value <= scalar.maximum:
+                self.error((*path, "ok"), f"ok value {value} does not fit {scalar.name}")
         for key, allowed in (
             ("adds", "length"),
             ("counts", "length"),
             ("covers", "checksum"),
             ("sequence", "value"),
+            ("ok", "status"),
             ("truncate", "content"),
             ("from_request", "checksum"),
             ("size", "optional"),
@@ -250,6 +257,7 @@ class FramingPass(FieldResolver):
             broadcast=item.get("broadcast"),
             flags=self.reference("flags", self.flags, item.get("flags"), (*path, "flags")),
             sequence=bool(item.get("sequence", False)),
+            ok=ok,
             truncate=role == "content" and item.get("truncate") == "trailing_zeros",
             endian=endian,
             bits=bits,

@@ -53,24 +53,27 @@ class EntrySpec:
 
 @dataclass(frozen=True)
 class SpaceSpec:
-    """A data space: `size` items (bits, or unsigned integers up to `maximum`) addressed 0..size-1, all 0 at first."""
+    """A data space: `size` items (bits, or integers `minimum`..`maximum`) addressed 0..size-1, all 0 at first."""
 
     name: str
     size: int
     bits: bool
     maximum: int
     access: str = "rw"
+    minimum: int = 0  # below 0: signed items, a value written wraps to them as two's complement does
 
 
 @dataclass(frozen=True)
 class RunSpec:
     """A run of a data space from the address in the request field `start`; `count` items for reads; for writes,
-    `value(current, fields)` computes what is stored (default: the request field's value)."""
+    `value(current, fields)` computes what is stored (default: the request field's value). `single`: read into one
+    number, the item itself rather than a list of one."""
 
     space: str
     start: str
     count: str = ""
     value: Callable[[int, dict[str, Any]], int] | None = None
+    single: bool = False
 
 
 @dataclass(frozen=True)
@@ -877,11 +880,12 @@ class Engine(FaultInjection):
             values[self.spec.address] = device.id
         return self._encode_reply(error.response, values)
 
-    def _read_space(self, device: VirtualDevice, run: RunSpec, given: dict[str, Any]) -> list[Any]:
+    def _read_space(self, device: VirtualDevice, run: RunSpec, given: dict[str, Any]) -> Any:
         start = int(given[run.start])
         items = device.spaces[run.space][start : start + (int(given[run.count]) if run.count else 1)]
         space = next(s for s in self.spec.spaces if s.name == run.space)
-        return [bool(v) for v in items] if space.bits else list(items)
+        read = [bool(v) for v in items] if space.bits else list(items)
+        return read[0] if run.single else read
 
     def _write_space(self, device: VirtualDevice, run: RunSpec, value: Any, given: dict[str, Any]) -> None:
         space = next(s for s in self.spec.spaces if s.name == run.space)
@@ -891,7 +895,10 @@ class Engine(FaultInjection):
         for offset, item in enumerate(values):
             current = items[start + offset]
             stored = run.value(current, given) if run.value is not None else int(item)
-            items[start + offset] = (1 if stored else 0) if space.bits else stored & space.maximum
+            span = space.maximum - space.minimum + 1  # the items' bits: a value wraps as it would on the wire
+            items[start + offset] = (
+                (1 if stored else 0) if space.bits else (stored - space.minimum) % span + space.minimum
+            )
 
     def _move(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any], written: set[str]) -> None:
         """Start a move to the target: a request field, or a memory entry this command has just written.

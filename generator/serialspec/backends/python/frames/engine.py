@@ -140,7 +140,8 @@ def size_rule(sizing: Message | Discriminator) -> str | None:
     *before, last = message.fields or (None,)
     if isinstance(last, Bytes) and last.size_from and all(fixed_size(f) is not None for f in before):
         # a reply's last bytes, as many as the request's field says (`size_from`): sized with that request
-        return f"SizeRule({sum(fixed_size(f) or 0 for f in before)}, request={python_name(last.size_from)!r})"
+        fixed = sum(fixed_size(f) or 0 for f in before) + last.size_from_adds
+        return f"SizeRule({fixed}, request={python_name(last.size_from)!r})"
     if found is None and text is not None:
         return f"SizeRule({text}, nul={text})"
     if found is None:

@@ -87,6 +87,8 @@ def subcommand_frames(
     for command in protocol.commands:
         if command.selector is None or layout.direction not in command.selector.offsets:
             continue
+        if command.selector.type.size != 1:  # a selector of several bytes: the general path reads it
+            continue
         by_size: dict[tuple[int, int], list[tuple[int, dict[str, Any]]]] = {}
         for sub in command.subcommands:
             message = sub.request if layout.direction == Direction.REQUEST else sub.response
@@ -210,6 +212,8 @@ def subcommand_rest_frames(
     found = []
     for command in protocol.commands:
         if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        if command.selector.type.size != 1:  # a selector of several bytes: the general path reads it
             continue
         at = command.selector.offsets[layout.direction]
         subs = []

@@ -197,6 +197,32 @@ def test_a_frame_without_a_length_is_sized_by_a_count_of_n_plus_k() -> None:
         )
 
 
+@pytest.mark.parametrize(
+    ("field", "key"),
+    [
+        ("{type: bytes, size: rest}", "size"),
+        ("{type: string, size: rest}", "size"),
+        ("{type: array, of: u8, count: rest}", "count"),
+        ("{type: group, count: rest, fields: {a: u8}}", "count"),
+    ],
+)
+def test_the_rest_of_a_frame_without_a_length_is_one_line(field: str, key: str) -> None:
+    """No length element, trailer or transform: nothing says where a frame whose last field takes the rest ends, so
+    the stream parser dropped every such frame as garbage (and a client waited for a reply it never saw). One line
+    instead; with a trailer the frame ends there and the spec stands."""
+    text = spec(f"        n: u8\n        tail: {field}\n", NO_LENGTH)
+    with pytest.raises(SpecErrors) as refused:
+        protocol_of(text)
+    row, column = len(text.splitlines()), text.splitlines()[-1].index(key) + 1 + len(key) + 2
+    assert str(refused.value) == (
+        f"counted.yaml:{row}:{column}: commands.probe.request.fields.tail.{key}: `{key}: rest` cannot size a frame "
+        "that has no length element, trailer or transform: a stream parser could not tell where it ends (give the "
+        f"frame a length element, or the field a {key} a field or a number says)"
+    )
+    ended = NO_LENGTH.replace("content]}\n", "content]}\n    end: {role: trailer, value: 0D}\n", 1)
+    protocol_of(spec(f"        n: u8\n        tail: {field}\n", ended))
+
+
 def test_the_c_refuses_a_negative_count_and_reads_the_others(package: ModuleType, tmp_path: Path) -> None:
     from test_c_backend import GCC, spec_driver
 

@@ -454,7 +454,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf(
         (Int(), Str()),
-        "bytes, string: a number, `rest` (up to the end of the content) or the name of an earlier integer field, "
+        "bytes, string: a number, `rest` (up to the end of the content; a frame that has no length element, trailer "
+        "or transform cannot end that way: a stream parser could not tell where, so it is refused) or the name of "
+        "an earlier integer field, "
         "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "
         "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE), or an expression over "
         "earlier integer fields, which stay in the message (`length - 2`: see `count`); array: the earlier "

@@ -193,6 +193,19 @@ def nul_ended(fields: tuple[Field, ...]) -> int | None:
     return None if any(size is None for size in sizes) else sum(size or 0 for size in sizes)
 
 
+def rest_taker(fields: tuple[Field, ...]) -> tuple[Field, str] | None:
+    """The field that takes the rest of the content (`size: rest`, `count: rest`) and its key, where nothing else
+    tells its size (a response's bytes `size_from` a request field are sized by the request)."""
+    for field in fields:
+        if isinstance(field, Bytes) and field.size == "rest" and not field.size_from:
+            return field, "size"
+        if isinstance(field, Text) and field.size == "rest":
+            return field, "size"
+        if isinstance(field, List | Group) and field.count == "rest":
+            return field, "count"
+    return None
+
+
 def sized_by_itself(fields: tuple[Field, ...]) -> bool:
     """Whether a content's size follows from its own bytes (a fixed size, a count at a fixed offset, a NUL): what
     sizes a frame that carries no length."""

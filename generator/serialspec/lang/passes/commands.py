@@ -35,6 +35,7 @@ from serialspec.lang.model import (
     sizing_message,
     why_not_picked,
 )
+from serialspec.lang.model.sizes import rest_taker, sized_by_itself
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
 
@@ -59,6 +60,7 @@ class Commands(FieldResolver):
             self.ctx.framing = self.wire_codes(self.ctx.commands, self.ctx.framing)
             self.check_codes(self.ctx.commands, self.ctx.framing)
             self.check_layouts(self.ctx.commands, self.ctx.framing)
+            self.check_sizable(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
             self.check_seeds(self.ctx.framing)
             self.ctx.framing = used_layouts(self.ctx.commands, self.ctx.framing)
@@ -465,6 +467,35 @@ class Commands(FieldResolver):
                         f"{message.direction.value} has fields",
                     )
 
+    def check_sizable(self, commands: list[Command], framing: Framing) -> None:
+        """A content whose size varies, in a layout with no length element, trailer or transform, is sized by its own
+        bytes (model/sizes.py): a count by an expression must be of the form a stream parser sizes it by, and no
+        field may take the rest (a stream parser could not tell where the frame ends: it would drop every one)."""
+        for command in commands:
+            if command.name in self.ctx.broken:
+                continue
+            for message in command.messages():
+                layout = framing.layout_of(message.direction, message.layout)
+                fields = message.fields
+                if layout.length is not None or layout.trailer or layout.transparency is not None:
+                    continue
+                low, high = content_bounds(fields)
+                if low == high:
+                    continue
+                where: Path = ("commands", command.name)
+                if message.subcommand is not None:
+                    where = (*where, "subcommands", message.subcommand)
+                where = (*where, message.direction.value, "fields")
+                if why := counts.unsized(fields):
+                    self.error((*where, why[0], why[1]), why[2])
+                elif not sized_by_itself(fields) and (rest := rest_taker(fields)):
+                    self.error(
+                        (*where, rest[0].name, rest[1]),
+                        f"`{rest[1]}: rest` cannot size a frame that has no length element, trailer or transform: a "
+                        "stream parser could not tell where it ends (give the frame a length element, or the field "
+                        f"a {rest[1]} a field or a number says)",
+                    )
+
     def check_answered_by(self, commands: list[Command]) -> None:
         responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
         for command in commands:
@@ -638,10 +669,6 @@ class Commands(FieldResolver):
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
-        if framing is not None and low != high and (why := counts.unsized(fields)):
-            layout = framing.layout_of(direction, str(value.get("layout") or ""))
-            if layout.length is None and not layout.trailer and layout.transparency is None:
-                self.error((*path, "fields", why[0], why[1]), why[2])
         padded = None
         if framing is not None and framing.layouts[direction].truncates and high != 0:
             if low != high:

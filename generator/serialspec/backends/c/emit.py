@@ -114,8 +114,8 @@ def ident(name: str) -> str:
 
 
 def comment(text: str) -> str:
-    """Spec text inside a C comment: one line, no comment end, ASCII-safe."""
-    return collapse(text).replace("*/", "* /").replace("/*", "/ *")
+    """Spec text inside a C comment: one line, no comment end, no trigraph (`??/` at a line's end splices it)."""
+    return collapse(text).replace("*/", "* /").replace("/*", "/ *").replace("??", "? ?")
 
 
 I32 = ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF)
@@ -420,7 +420,7 @@ def cap_macro(ctx: Ctx, path: str, default: int) -> str:
 def field_doc(f: Field) -> str:
     parts = [comment(f.description)] if f.description else []
     if isinstance(f, Scalar | Array | List) and f.unit:
-        parts.append(f"unit: {f.unit}")
+        parts.append(f"unit: {comment(f.unit)}")
     if isinstance(f, Scalar) and f.scale:
         parts.append(f"scale: {f.scale:g} per unit")
     if isinstance(f, Scalar) and f.offset:

@@ -223,6 +223,8 @@ def least(f: Field, siblings: tuple[Field, ...]) -> Field:
     """`f`, sized or counted by a sibling whose range starts above 0, as of that smallest size or count: its blank
     (none of it) would have a size the sizing field refuses."""
     name = f.size if isinstance(f, Bytes | Text) else f.count if isinstance(f, Group | List) else None
+    if not isinstance(name, str):
+        return f
     counter = next((s for s in siblings if s.name == name and isinstance(s, Scalar)), None)
     if counter is None or counter.minimum <= 0 or isinstance(f, List) and f.count_from:
         return f

@@ -58,20 +58,22 @@ class FieldResolver(Pass):
 
     def fields(self, raw: dict[str, Any], path: Path, parent: list[Field] | None) -> tuple[Field, ...]:
         resolved: list[Field] = []
+        names: set[str] = set()
         for name, item in raw.items():
             field_path = (*path, name)
             self.name(name, field_path, "field name", RESERVED_FIELD_NAMES, keywords=True)
-            if any(f.name == name for f in resolved):
+            if name in names:
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
             if field is not None:
                 resolved.append(field)
+                names.add(field.name)
         self.check_values(resolved, path)
-        return tuple(self.bit_runs(resolved, path))
+        return tuple(self.bit_runs(resolved, path, complete=len(resolved) == len(raw)))
 
-    def bit_runs(self, fields: list[Field], path: Path) -> list[Field]:
+    def bit_runs(self, fields: list[Field], path: Path, complete: bool = True) -> list[Field]:
         """Each field of a bit run (encodings/bit_run.py) with its place; a run that does not end on a byte boundary
-        is an error at its first field."""
+        is an error at its first field (unless a field is missing, its mistake said: the runs are not known)."""
 
         def bits(f: Field) -> int | None:
             plain = isinstance(f, Scalar) and not (f.type.is_float or f.bits or f.sign_magnitude or f.seven_bit)
@@ -81,7 +83,7 @@ class FieldResolver(Pass):
 
         listed = [(f.name, bits(f), isinstance(f, Scalar) and bit_run.width(f.type.name) is not None) for f in fields]
         runs, problem = bit_run.runs(listed)
-        if problem is not None:
+        if problem is not None and complete:
             self.error((*path, problem[0]), problem[1])
         by_name = {f.name: f for f in fields}
         for run in runs:
@@ -465,7 +467,9 @@ class FieldResolver(Pass):
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         scalar = self.stored(field_type(spec["type"]), sign_magnitude, (*path, "encoding"))
         if bit_run.width(scalar.name) and (odd := [k for k in ("bits", "flags", "encoding", "endian") if k in spec]):
-            self.error((*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)")
+            raise self.fail(
+                (*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)"
+            )
         seven_bits = spec.get("encoding") == seven_bit.NAME
         if seven_bits and (why := seven_bit.problem(scalar.name, scalar.signed, scalar.is_float)):
             self.error((*path, "encoding"), why)

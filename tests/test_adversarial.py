@@ -16,7 +16,7 @@ from construct import ConstructError, Struct, Terminated
 from hostile_run import generated
 from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors
-from serialspec.lang.loader import load_file
+from serialspec.lang.loader import load_file, load_text
 from serialspec.runtime.errors import DecodeError
 from test_c_backend import FLAGS, GCC
 from test_codec import frame_content
@@ -140,10 +140,18 @@ def test_some_spec_checks_its_outputs() -> None:
 
 @pytest.mark.parametrize("path", OUTPUTS)
 def test_spec_outputs_compile(path: Path, tmp_path: Path) -> None:
-    """A spec marked `# outputs: c lua`: its C compiles under the strict flags (gcc, syntax only) and its Wireshark
-    dissector loads in tshark (where each is installed): spec text cannot break out of their comments and strings."""
-    lines, files = generated(load_file(str(path), path.name))
+    """A spec marked `# outputs: c lua`, under a file name that closes comments and strings too: every module of its
+    Python package imports, its C compiles under the strict flags (gcc, syntax only) and its Wireshark dissector
+    loads in tshark (where each is installed): spec text cannot break out of their comments and strings."""
+    text = path.read_text(encoding="utf-8")
+    lines, files = generated(load_text(text, f'{path.stem}"""\n*/ ]] --[[ ??/ \\N{{x}}.yaml'))
     assert lines == []
+    package_name = next(name.partition("/")[0] for name in files if name.endswith("/__init__.py"))
+    modules = {name.partition("/")[2]: body for name, body in files.items() if name.startswith(package_name + "/")}
+    with imported(package_name, modules):
+        for name in modules:
+            if name.endswith(".py") and name != "__init__.py":
+                importlib.import_module(f"{package_name}.{name.removesuffix('.py')}")
     for name, body in files.items():
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / name).write_text(body, encoding="utf-8")

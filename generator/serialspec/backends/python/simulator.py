@@ -426,7 +426,7 @@ def simulator_module(protocol: Protocol) -> str:
         error=error,
         unwrap=unwraps,
         timeout=timeout,
-        spec_path=protocol.spec_path,
+        spec_path=one_line(protocol.spec_path),
         title=one_line(protocol.title),
         package=protocol.name,
         description=one_line(device.description),

@@ -40,7 +40,7 @@ LABEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 # --- reserved names: every name generated code uses itself, so that no spec name can shadow one -----------------
 
 # Attribute and parameter names the generated classes and methods use themselves.
-RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self"})
+RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self", "cls"})
 # A field is also a parameter of a client method, whose body has these locals and calls these builtins (a parameter
 # of the same name would shadow them); `id`, a usual address field, is a builtin generated code never calls.
 RESERVED_FIELD_NAMES = (

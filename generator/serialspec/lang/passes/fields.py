@@ -481,6 +481,8 @@ class FieldResolver(Pass):
         if value_enum is not None and spec.get("range") is None:
             low, high = enum_span(value_enum, low, high)
         const = spec.get("const")
+        if isinstance(const, bool) or not isinstance(const, int):  # none, or not an integer (the grammar said so)
+            const = None
         if const is not None and not low <= const <= high:
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
         if spec.get("scale") == 0:

@@ -6,6 +6,7 @@ binary frames have yet are refused one line each, so that nothing a spec says is
 
 from __future__ import annotations
 
+import math
 import string
 from dataclasses import replace
 from decimal import Decimal
@@ -64,6 +65,8 @@ DIGITS = 18
 
 def _fits_digits(bound: float) -> bool:
     """Whether a range bound is a decimal of at most DIGITS digits, none of them beyond the DIGITS-th decimal."""
+    if not math.isfinite(bound):
+        return True  # not a number of digits at all: the grammar's line says so
     number = (Decimal(bound) if isinstance(bound, int) else Decimal(repr(float(bound)))).normalize()
     exponent = number.as_tuple().exponent
     assert isinstance(exponent, int)

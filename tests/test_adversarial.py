@@ -14,8 +14,10 @@ import yaml
 from conftest import ALL, SHIPPED
 from construct import ConstructError, Struct, Terminated
 from hostile_run import generated
+from serialspec.backends import Unsupported
+from serialspec.backends.c.build import files as c_files
 from serialspec.backends.python.memory import imported
-from serialspec.lang import SpecErrors
+from serialspec.lang import SpecErrors, load_protocol
 from serialspec.lang.loader import load_file, load_text
 from serialspec.runtime.errors import DecodeError
 from test_c_backend import FLAGS, GCC
@@ -119,6 +121,10 @@ def test_spec(path: Path) -> None:
                 with pytest.raises(ConstructError) as refused:
                     content.build(yaml.safe_load(values + "}"))
                 assert reason in str(refused.value)
+            elif note.startswith("c refused: "):  # the C target refuses the spec in this line
+                with pytest.raises(Unsupported) as unsupported:
+                    c_files(load_protocol(str(path), path.name))
+                assert str(unsupported.value) == note.removeprefix("c refused: ")
             elif note.startswith("simulate "):  # fed these frames in turn, the simulator answers or not, never raises
                 listed = note.partition(": ")[2]
                 frames = [hex_bytes(frame) for frame in listed.removesuffix(" (answered)").split("|")]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import builtins
 import keyword
+import math
 import re
 import sys
 from dataclasses import field
@@ -377,6 +378,9 @@ class Pass:
         given_low, given_high = given
         if given_low > given_high:
             self.error(path, f"range [{given_low}, {given_high}] is empty")
+        fractions = [b for b in given if isinstance(b, float) and math.isfinite(b) and not b.is_integer()]
+        if fractions and not scalar.is_float:  # a bound between two values: C and Python would round it apart
+            self.error(path, f"range bound {fractions[0]} is no whole number: a {scalar.name} holds whole numbers")
         if given_low < low or given_high > high:
             what = f"{scalar.name} {seven_bit.NAME}" if seven_bits else scalar.name
             self.error(path, f"range [{given_low}, {given_high}] does not fit {what} ({low:g}..{high:g})")

@@ -194,3 +194,13 @@ def test_a_line_of_junk_on_stdin_is_told_quoted() -> None:
     finally:
         sys.stdin = real
     assert code == 1 and len(err.splitlines()) == 1 and "\x1b" not in err and "\x07" not in err, err
+
+
+def test_a_folder_or_a_device_named_as_a_spec_is_said_so(tmp_path: Path) -> None:
+    """`check` and `generate` of a folder, or of /dev/null, said "no such spec file" of something that is there."""
+    folder = tmp_path / "lamp.yaml"
+    folder.mkdir()
+    for verb in ("check", "generate"):
+        for path, said in ((folder, "is a folder, not a spec file"), (Path("/dev/null"), "is a device or a pipe")):
+            code, _, err = run(verb, str(path), *(["--out", str(tmp_path / "out")] if verb == "generate" else []))
+            assert code == 1 and f":1:1: {said}" in err.splitlines()[0], err

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import importlib
 import re
+import shutil
+import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -12,14 +14,20 @@ import yaml
 from conftest import ALL, SHIPPED
 from construct import ConstructError, Struct, Terminated
 from hostile_run import generated
+from serialspec.backends import Unsupported
+from serialspec.backends.c.build import files as c_files
 from serialspec.backends.python.memory import imported
-from serialspec.lang import SpecErrors
-from serialspec.lang.loader import load_file
+from serialspec.lang import SpecErrors, load_protocol
+from serialspec.lang.loader import load_file, load_text
 from serialspec.runtime.errors import DecodeError
+from test_c_backend import FLAGS, GCC
 from test_codec import frame_content
 
 CORPUS = Path(__file__).resolve().parent / "adversarial"
 LINE = re.compile(r"^(?P<file>[\w.]+\.yaml):(?P<line>[1-9]\d*):(?P<column>[1-9]\d*): (?P<rest>.+)$")
+
+
+TSHARK = shutil.which("tshark")
 
 
 def cases(kind: str) -> list[Any]:
@@ -113,6 +121,10 @@ def test_spec(path: Path) -> None:
                 with pytest.raises(ConstructError) as refused:
                     content.build(yaml.safe_load(values + "}"))
                 assert reason in str(refused.value)
+            elif note.startswith("c refused: "):  # the C target refuses the spec in this line
+                with pytest.raises(Unsupported) as unsupported:
+                    c_files(load_protocol(str(path), path.name))
+                assert str(unsupported.value) == note.removeprefix("c refused: ")
             elif note.startswith("simulate "):  # fed these frames in turn, the simulator answers or not, never raises
                 listed = note.partition(": ")[2]
                 frames = [hex_bytes(frame) for frame in listed.removesuffix(" (answered)").split("|")]
@@ -123,3 +135,42 @@ def test_spec(path: Path) -> None:
                 assert answered[:-1] == [[]] * (len(frames) - 1)
                 if listed.endswith(" (answered)"):  # the last one is answered
                     assert answered[-1]
+
+
+OUTPUTS = [p for p in cases("specs") if "\n# outputs:" in "\n" + p.values[0].read_text(encoding="utf-8")]
+
+
+def test_some_spec_checks_its_outputs() -> None:
+    assert OUTPUTS
+
+
+@pytest.mark.parametrize("path", OUTPUTS)
+def test_spec_outputs_compile(path: Path, tmp_path: Path) -> None:
+    """A spec marked `# outputs: c lua`, under a file name that closes comments and strings too: every module of its
+    Python package imports, its C compiles under the strict flags (gcc, syntax only) and its Wireshark dissector
+    loads in tshark (where each is installed): spec text cannot break out of their comments and strings."""
+    text = path.read_text(encoding="utf-8")
+    lines, files = generated(load_text(text, f'{path.stem}"""\n*/ ]] --[[ ??/ \\N{{x}}.yaml'))
+    assert lines == []
+    package_name = next(name.partition("/")[0] for name in files if name.endswith("/__init__.py"))
+    modules = {name.partition("/")[2]: body for name, body in files.items() if name.startswith(package_name + "/")}
+    with imported(package_name, modules):
+        for name in modules:
+            if name.endswith(".py") and name != "__init__.py":
+                importlib.import_module(f"{package_name}.{name.removesuffix('.py')}")
+    for name, body in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(body, encoding="utf-8")
+    sources = [tmp_path / name for name in files if name.endswith(".c")]
+    scripts = [tmp_path / name for name in files if name.endswith(".lua")]
+    assert sources and scripts
+    if GCC is not None:
+        for source in sources:
+            built = subprocess.run(
+                [GCC, *FLAGS, "-fsyntax-only", "-I", str(source.parent), str(source)], text=True, capture_output=True
+            )
+            assert built.returncode == 0, built.stderr
+    if TSHARK is not None:
+        options = [f"-Xlua_script:{script}" for script in scripts]
+        loaded = subprocess.run([TSHARK, *options, "-r", "/dev/null"], text=True, capture_output=True)
+        assert "Lua" not in loaded.stderr, loaded.stderr

@@ -165,3 +165,42 @@ def test_strict_encode_at_the_cli(value: str, words: str) -> None:
     assert (code, out) == (1, "")
     assert len(err.splitlines()) == 1 and words in err, err
     assert "angle" in err or "--json" in err
+
+
+def test_a_binary_file_as_a_capture_is_one_line_naming_its_line(tmp_path: Path) -> None:
+    """Bytes that are not UTF-8 as a capture: `decode --file`, `replay` and `export` (and `plot`) refuse the line that
+    holds them (export raised UnicodeDecodeError; replay said only "'utf-8' codec can't decode")."""
+    capture = tmp_path / "junk.capture"
+    capture.write_bytes(b"# serialspec capture: feetech_sms\n\x9b\xff\x1b[2J\x00junk\n")
+    pcap = str(tmp_path / "out.pcap")
+    for argv in (
+        ["decode", "feetech_sms", "--file", str(capture)],
+        ["replay", str(capture), "--port", "/dev/null", "--spec", "feetech_sms"],
+        ["export", str(capture), "--pcap", pcap],
+    ):
+        code, _, err = run(*argv)
+        assert code == 1 and len(err.splitlines()) == 1, (argv, err)
+        assert "line 2: " in err and "\x1b" not in err, err
+
+
+def test_a_line_of_junk_on_stdin_is_told_quoted() -> None:
+    """`decode -` names a line it cannot read as hex quoted and cut short, not as it came (terminal escapes)."""
+    import sys
+
+    lines = io.StringIO("\x1b]0;pwned\x07" + "zz" * 100 + "\n")
+    real, sys.stdin = sys.stdin, lines
+    try:
+        code, _, err = run("decode", "feetech_sms", "-")
+    finally:
+        sys.stdin = real
+    assert code == 1 and len(err.splitlines()) == 1 and "\x1b" not in err and "\x07" not in err, err
+
+
+def test_a_folder_or_a_device_named_as_a_spec_is_said_so(tmp_path: Path) -> None:
+    """`check` and `generate` of a folder, or of /dev/null, said "no such spec file" of something that is there."""
+    folder = tmp_path / "lamp.yaml"
+    folder.mkdir()
+    for verb in ("check", "generate"):
+        for path, said in ((folder, "is a folder, not a spec file"), (Path("/dev/null"), "is a device or a pipe")):
+            code, _, err = run(verb, str(path), *(["--out", str(tmp_path / "out")] if verb == "generate" else []))
+            assert code == 1 and f":1:1: {said}" in err.splitlines()[0], err

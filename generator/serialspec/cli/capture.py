@@ -65,9 +65,10 @@ class Writer:
 
 
 def open_text(path: str) -> TextIO:
-    """A capture file opened for reading; SerialspecError naming it when it cannot be."""
+    """A capture file opened for reading; SerialspecError naming it when it cannot be. Bytes that are not UTF-8 (a
+    binary file) read as U+FFFD: the line that holds them is then refused, by number, as no hex."""
     try:
-        return open(path, encoding="utf-8")
+        return open(path, encoding="utf-8", errors="replace")
     except OSError as exc:
         raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from types import ModuleType
 
 from serialspec.cli.protocols import SPEC_HELP, installed_package, open_spec, submodule
-from serialspec.runtime.errors import DecodeError, SerialspecError
+from serialspec.runtime.errors import DecodeError, SerialspecError, shown
 from serialspec.runtime.hexbytes import parse_hex
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -109,7 +109,8 @@ def decode_frames(
         except (DecodeError, SerialspecError) as exc:
             hint = " (--direction request|response)" if str(exc).startswith("give the direction") else ""
             hint = " (--request HEX)" if str(exc).endswith("give the request") else hint
-            print(f"serialspec decode: {text.strip()}: {exc}{hint}", file=sys.stderr)
+            given = text.strip()  # as typed, or quoted and cut short where it holds what a terminal would act on
+            print(f"serialspec decode: {given if given.isprintable() else shown(given)}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue
         show(described(message, frame), args.json)

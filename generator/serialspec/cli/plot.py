@@ -104,17 +104,15 @@ def _pyplot() -> ModuleType:
 
 def read_capture(path: str) -> list[capture.Chunk]:
     try:
-        with open(path, encoding="utf-8") as lines:
+        with capture.open_text(path) as lines:
             return [chunk for _, chunk in capture.read(lines)]
-    except OSError as exc:
-        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
     except ValueError as exc:
         raise SerialspecError(f"{path}: {exc}") from None
 
 
 def _named_protocol(path: str) -> str:
     """The protocol a capture's first line names (`# serialspec capture: NAME`)."""
-    with open(path, encoding="utf-8") as lines:
+    with capture.open_text(path) as lines:
         first = lines.readline()
     name = first.removeprefix("# serialspec capture:").strip() if first.startswith("# serialspec capture:") else ""
     if not name:

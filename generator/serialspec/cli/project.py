@@ -171,7 +171,13 @@ def expected_files(
     for spec in proj.specs:
         if not spec.is_file():
             also = "" if spec.suffix else ", nor a generated protocol package of that name"
-            errors.append(SpecError(proj.display(spec), 1, 1, "", f"no such spec file{also}"))
+            if spec.is_dir():  # the loader's words
+                said = "is a folder, not a spec file"
+            elif spec.exists():
+                said = "is a device or a pipe, not a spec file"
+            else:
+                said = f"no such spec file{also}"
+            errors.append(SpecError(proj.display(spec), 1, 1, "", said))
             continue
         try:
             outputs = spec_outputs(spec, proj.display(spec), with_data=proj.reference is not None)

@@ -87,11 +87,8 @@ def run(args: argparse.Namespace) -> int:
 def _lines(path: str) -> list[str]:
     if path == "-":
         return sys.stdin.readlines()
-    try:
-        with open(path, encoding="utf-8") as stream:
-            return stream.readlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SerialspecError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    with capture.open_text(path) as stream:
+        return stream.readlines()
 
 
 def _package(spec: str | None, required: bool) -> tuple[Any, str | None]:

@@ -17,7 +17,9 @@ class SpecError:
 
     def __str__(self) -> str:
         where = f"{self.path}: " if self.path else ""
-        return f"{self.file}:{self.line}:{self.column}: {where}{self.message}"
+        line = f"{self.file}:{self.line}:{self.column}: {where}{self.message}"
+        # one line whatever the file's name or the text quoted: anything unprintable (a newline) escaped
+        return line if line.isprintable() else "".join(c if c.isprintable() else f"\\x{ord(c):02x}" for c in line)
 
 
 #: How many mistakes str(SpecErrors) shows, in file order; a last line counts the rest.

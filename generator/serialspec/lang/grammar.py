@@ -333,9 +333,18 @@ _WANTED: dict[type[Shape], str] = {
 }
 
 
+# A number with an exponent that YAML 1.1 (PyYAML) reads as text: one without a point or without the exponent's sign
+_EXPONENT_AS_TEXT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+
+
 def _kind(value: Any) -> str:
     if value is None:
         return "nothing"
+    if isinstance(value, str) and _EXPONENT_AS_TEXT.fullmatch(value):
+        mantissa, _, exponent = value.lower().partition("e")
+        mantissa += "" if "." in mantissa else ".0"
+        written = f"{mantissa}e{exponent if exponent[0] in '+-' else '+' + exponent}"
+        return f"text ({value!r}: YAML takes an exponent only after a point and with its sign: write {written})"
     if isinstance(value, float):
         return f"a number ({value!r})"  # where an integer was wanted, 1.0 shows why it is not one
     return {
@@ -530,12 +539,14 @@ _FIELD_LONG: dict[str, Shape] = {
         "decoded value keeps the digits it was sent with); a decimal without one writes a float in its shortest "
         "form (2.5, never rounded to 2).",
         minimum=0,
+        maximum=18,
         example=4,
     ),
     "width": Int(
         "text integer, decimal: digits before the point, zero-padded; angle: digits of the degrees (2 for a "
         "latitude, 3 for a longitude).",
         minimum=1,
+        maximum=20,
         example=3,
     ),
     "letters": MapOf(

@@ -72,8 +72,10 @@ MAX_DEPTH = 64
 EXPANSION_FACTOR = 4
 EXPANSION_SLACK = 10_000
 _PLAIN_TAGS = frozenset({"tag:yaml.org,2002:map", "tag:yaml.org,2002:seq"})
-# Control characters (C0 but tab, newline, carriage return; DEL; C1) have no place in a spec's text.
-CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
+# Control characters (C0 but tab, newline, carriage return; DEL; C1) have no place in a spec's text, nor have the
+# bidirectional embeddings, overrides and isolates, which make generated code read other than it runs (compilers
+# refuse them unpaired in a comment: gcc's -Wbidi-chars).
+CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
 
 def load_file(path: str, display_name: str | None = None) -> Located:

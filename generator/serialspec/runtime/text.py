@@ -292,6 +292,9 @@ class TextFraming:
         so that it encodes again without it."""
         covered = self._checked(body, direction)
         sentence = self._decode_body(covered, direction, reply)
+        if self.checksum is not None and sentence.direction not in self.checksummed:
+            # a code of the other direction alone (asked for as this one): it carries no checksum, all its text
+            return self._decode_body(body, sentence.direction, reply)
         if self.checksum is not None and covered == body:
             return replace(sentence, unchecked=True)
         return sentence

@@ -2,9 +2,9 @@
 /* u-blox UBX (GNSS receivers): C99 codec and stream parser (serialspec 0.1.0). No malloc, no mutable
  * statics, no packed structs; values built with shifts (any host byte order). The generated code may be
  * used, copied and changed without restriction (it carries the spec's facts, not serialspec's code's licence). */
-/* Golden vectors of u-blox UBX (GNSS receivers): every example frame the spec records (a frame, its direction and
- * the message it decodes to) and every frame an erratum says the document prints wrong (the decoder refuses
- * it). test/check_vectors.c checks the codec and the parser against them. */
+/* Golden vectors of u-blox UBX (GNSS receivers): every example frame the spec records (a frame, its
+ * direction and the message it decodes to) and every frame an erratum says the document prints wrong (the
+ * decoder refuses it). test/check_vectors.c checks the codec and the parser against them. */
 
 #ifndef UBX_VECTORS_H
 #define UBX_VECTORS_H

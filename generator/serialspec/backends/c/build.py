@@ -4,6 +4,9 @@ none of which imports it."""
 
 from __future__ import annotations
 
+import re
+
+from serialspec.backends import Unsupported
 from serialspec.backends.c import length_byte, text
 from serialspec.backends.c.emit import Ctx, refuse_unsupported
 from serialspec.backends.c.files import header, json_header, json_source, source
@@ -13,8 +16,36 @@ from serialspec.backends.c.vectors import check_vectors, vectors_header
 from serialspec.backends.common.frames import refuse_code_forms
 from serialspec.lang.model import Protocol
 
+# The names a header defines: its macros, and the constants of its enums (`enum { P_MODE_SLOW = 0, P_MODE_FAST }`)
+_MACRO = re.compile(r"^#define (\w+)", re.MULTILINE)
+_ENUM = re.compile(r"\benum\s*\w*\s*\{([^}]*)\}")
+_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
+_CONSTANT = re.compile(r"\s*(\w+)")
+
 
 def files(protocol: Protocol) -> dict[str, str]:
+    made = _files(protocol)
+    for name, body in made.items():
+        if name.endswith(".h"):
+            refuse_clashing_names(body)
+    return made
+
+
+def refuse_clashing_names(header_text: str) -> None:
+    """Spec names make C names (enum `role`'s value `host` is P_ROLE_HOST, command `move`'s request P_MOVE_REQUEST):
+    two alike, one of them perhaps the target's own (P_ROLE_HOST, P_E_RANGE, a capacity's P_..._MAX), would not
+    compile. The target refuses such a spec naming the C name; renaming one of the spec's names fixes it."""
+    names = _MACRO.findall(header_text)
+    for body in _ENUM.findall(_COMMENT.sub("", header_text)):
+        names += [found[1] for item in body.split(",") if (found := _CONSTANT.match(item))]
+    seen: set[str] = set()
+    for name in names:
+        if name in seen:
+            raise Unsupported(f"two spec names make the one C name {name}: rename one of them")
+        seen.add(name)
+
+
+def _files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:  # a text protocol: backends/c/text.py
         return text.files(protocol, protocol.text)
     refuse_unsupported(protocol)

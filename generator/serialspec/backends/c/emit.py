@@ -115,8 +115,8 @@ def ident(name: str) -> str:
 
 
 def comment(text: str) -> str:
-    """Spec text inside a C comment: one line, no comment end, ASCII-safe."""
-    return collapse(text).replace("*/", "* /").replace("/*", "/ *")
+    """Spec text inside a C comment: one line, no comment end, no trigraph (`??/` at a line's end splices it)."""
+    return collapse(text).replace("*/", "* /").replace("/*", "/ *").replace("??", "? ?")
 
 
 I32 = ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF)
@@ -421,7 +421,7 @@ def cap_macro(ctx: Ctx, path: str, default: int) -> str:
 def field_doc(f: Field) -> str:
     parts = [comment(f.description)] if f.description else []
     if isinstance(f, Scalar | Array | List) and f.unit:
-        parts.append(f"unit: {f.unit}")
+        parts.append(f"unit: {comment(f.unit)}")
     if isinstance(f, Scalar) and f.scale:
         parts.append(f"scale: {f.scale:g} per unit")
     if isinstance(f, Scalar) and f.offset:
@@ -1032,6 +1032,13 @@ def uses(fields: tuple[Field, ...], kinds: tuple[type, ...]) -> bool:
     return False
 
 
+def bit_lists(fields: tuple[Field, ...]) -> bool:
+    """A list of bits at any depth (a group's item's too): the encoder's `len`, its bytes."""
+    return any(
+        (isinstance(f, List) and f.item is None) or (isinstance(f, Group) and bit_lists(f.fields)) for f in fields
+    )
+
+
 def uses_k(fields: tuple[Field, ...]) -> bool:
     """A text whose end is found by a scan (NUL-terminated, or padded) at any depth: the decoder's `k`."""
     return any(
@@ -1436,7 +1443,7 @@ def encoder(ctx: Ctx, message: Message) -> str:
             locals_.append(f"    uint32_t v1_{ident(f.name)};")
         elif isinstance(f, Scalar) and f.value is not None:
             locals_.append(f"    int64_t v1_{ident(f.name)};")
-    if any(isinstance(f, List) and f.item is None for f in message.fields):
+    if bit_lists(message.fields):
         locals_.append("    size_t len;")
     parameters, ending = "uint8_t *c, size_t cap", ["    *n = o;"]
     if message.padded is not None:  # made whole in z, sent without its trailing zero bytes (at least one)

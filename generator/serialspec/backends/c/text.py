@@ -118,7 +118,7 @@ class TextC:
                     mems.append(f"    {group} {ident(item.name)}[{item.max_count}]; /* {comment(item.description)} */")
                     mems.append(f"    uint8_t {ident(item.name)}_count; /* groups sent, up to {item.max_count} */")
             body = "\n".join(mems) or "    uint8_t unused_;"
-            title = f"/* {comment(m.title)} ({m.code}, {m.direction.value}) */"
+            title = f"/* {comment(m.title)} ({comment(m.code)}, {m.direction.value}) */"
             out.append(f"{title}\ntypedef struct {{\n{body}\n}} {p}_{mid(m)}_t;")
         return "\n\n".join(out)
 
@@ -335,7 +335,8 @@ const char *{p}_result_name(int result);
             lines.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {body}\n    }}")
             at += size * item.count  # a repeat up to max_count comes last
         used = "\n".join(lines)
-        return f"""/* {comment(m.title)} ({m.code}, {m.direction.value}): each field in turn, an empty one absent. */
+        head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
+        return f"""/* {head}: each field in turn, an empty one absent. */
 static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
 {{
     size_t s = 0u, len = 0u, g = 0u, groups = 0u;
@@ -429,7 +430,8 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
             inner = "\n".join(self.write(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
             writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
-        return f"""/* {comment(m.title)} ({m.code}, {m.direction.value}): the range checks (when asked), then each
+        head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
+        return f"""/* {head}: the range checks (when asked), then each
  * field after a separator, an absent one empty. */
 static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
 {{

@@ -9,7 +9,7 @@ program runs in our tests under every compiler of the matrix.
 from __future__ import annotations
 
 from serialspec.backends.c import requests as asking
-from serialspec.backends.c.emit import Ctx, msg_id
+from serialspec.backends.c.emit import Ctx, comment, msg_id
 from serialspec.backends.c.files import banner
 from serialspec.lang.model import Direction, Message, Protocol
 
@@ -94,9 +94,9 @@ def vectors_header(ctx: Ctx) -> str:
     end = f"    {{NULL, {P}_REQUEST, {P}_KIND_NONE, NULL, 0u{none}}} /* end */"
     return (
         banner(protocol)
-        + f"/* Golden vectors of {protocol.title}: every example frame the spec records (a frame, its direction and\n"
-        " * the message it decodes to) and every frame an erratum says the document prints wrong (the decoder refuses\n"
-        " * it). test/check_vectors.c checks the codec and the parser against them. */\n\n"
+        + f"/* Golden vectors of {comment(protocol.title)}: every example frame the spec records (a frame, its\n"
+        " * direction and the message it decodes to) and every frame an erratum says the document prints wrong (the\n"
+        " * decoder refuses it). test/check_vectors.c checks the codec and the parser against them. */\n\n"
         f"#ifndef {P}_VECTORS_H\n#define {P}_VECTORS_H\n\n"
         f'#include "../{p}.h"\n\n'
         "typedef struct {\n"
@@ -160,7 +160,7 @@ def check_vectors(ctx: Ctx) -> str:
         expect = f"            if (asked)\n                {p}_parser_expect_reply(&parser, &req);\n"
     return (
         banner(protocol)
-        + f"/* Checks the generated {protocol.title} C against the spec's golden vectors: build it with\n"
+        + f"/* Checks the generated {comment(protocol.title)} C against the spec's golden vectors: build it with\n"
         f" *     cc -std=c99 -I.. check_vectors.c ../{p}.c -o check_vectors && ./check_vectors\n"
         " * It prints one line per failure and a summary, and exits 1 when anything failed. */\n\n"
         "#include <stdio.h>\n#include <string.h>\n\n"

@@ -671,7 +671,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         errors=errors,
         model_map=model_map,
         model_names=", ".join(m.name for m in device.models) if device is not None else "",
-        spec_path=protocol.spec_path,
+        spec_path=one_line(protocol.spec_path),
         title=one_line(protocol.title),
         package=protocol.name,
         class_name=class_name,

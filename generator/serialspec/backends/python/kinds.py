@@ -565,16 +565,19 @@ def byte_order_free(fmt: str) -> bool:
 def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
     """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
     run: list[SpecField] = []
+    order: str | None = None  # the run's byte order so far (one_order of the run, kept as it grows)
     for f in fields:
         if is_fixed_run_member(f):
-            if not one_order([*run, f]):  # a field in another byte order starts a run of its own
+            own = struct_order(f)
+            if own is not None and order is not None and own != order:  # another byte order: a run of its own
                 yield run
-                run = []
+                run, order = [], None
             run.append(f)
+            order = order or own
             continue
         if run:
             yield run
-            run = []
+            run, order = [], None
         yield f
     if run:
         yield run

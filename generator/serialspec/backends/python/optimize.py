@@ -9,6 +9,7 @@ statements and gives statements, and none reads generated source.
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from dataclasses import replace
 
@@ -114,6 +115,7 @@ def deferred_item_checks(body: Block) -> Block:
 # with a local `var_name` that reads it once up front. The marks are characters no Python the backend writes holds
 # (names are identifiers; spec text reaches code only through repr() of ASCII keys and names).
 _OPEN, _CLOSE = "\u27e8", "\u27e9"
+_HOLE = re.compile(f"{_OPEN}[^{_CLOSE}]*{_CLOSE}")
 
 
 def field_read(var: str, name: str) -> str:
@@ -191,11 +193,9 @@ def _filled(statement: Statement, local: dict[str, str]) -> Statement:
     def fill(text: str) -> str:
         if _OPEN not in text:
             return text
-        for hole, name in local.items():
-            text = text.replace(hole, name)
         if not local:  # the last pass: every hole left is an attribute read
-            text = text.replace(_OPEN, "").replace(_CLOSE, "")
-        return text
+            return text.replace(_OPEN, "").replace(_CLOSE, "")
+        return _HOLE.sub(lambda hole: local.get(hole[0], hole[0]), text)  # one pass, whatever the holes
 
     match statement:
         case Code():

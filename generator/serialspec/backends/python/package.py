@@ -60,7 +60,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     spec = protocol  # the spec's names, for the simulator: it works on to_fields()'s dicts, keyed by them
     protocol = python_view(protocol)  # fields named after Python keywords: their attributes (`class_`)
     code = PackageCode(protocol)
-    base = {"spec_path": protocol.spec_path, "title": one_line(protocol.title), "package": protocol.name}
+    base = {"spec_path": one_line(protocol.spec_path), "title": one_line(protocol.title), "package": protocol.name}
+    base["spec_file"] = protocol.spec_path  # as it is, in a Python string (SPEC)
     messages = {m.class_name: m for m in protocol.messages()}
     classes = []
     for cls in [*code.helper_classes, *code.message_classes]:

@@ -98,7 +98,7 @@ def registers_module(protocol: Protocol) -> str:
         )
     return render(
         "registers.py.j2",
-        spec_path=protocol.spec_path,
+        spec_path=one_line(protocol.spec_path),
         title=one_line(protocol.title),
         byte_order=protocol.byte_order,
         tables=tables,

@@ -225,6 +225,8 @@ def least(f: Field, siblings: tuple[Field, ...]) -> Field:
     """`f`, sized or counted by a sibling whose range starts above 0, as of that smallest size or count: its blank
     (none of it) would have a size the sizing field refuses."""
     name = f.size if isinstance(f, Bytes | Text) else f.count if isinstance(f, Group | List) else None
+    if not isinstance(name, str):
+        return f
     counter = next((s for s in siblings if s.name == name and isinstance(s, Scalar)), None)
     if counter is None or counter.minimum <= 0 or isinstance(f, List) and f.count_from:
         return f
@@ -428,7 +430,7 @@ def simulator_module(protocol: Protocol) -> str:
         error=error,
         unwrap=unwraps,
         timeout=timeout,
-        spec_path=protocol.spec_path,
+        spec_path=one_line(protocol.spec_path),
         title=one_line(protocol.title),
         package=protocol.name,
         description=one_line(device.description),

@@ -100,7 +100,7 @@ def structs_module(protocol: Protocol) -> str:
         frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES{asked[d]})"} for d in Direction]
     return render(
         "structs.py.j2",
-        spec_path=protocol.spec_path,
+        spec_path=one_line(protocol.spec_path),
         title=one_line(protocol.title),
         contents=contents,
         tables=tables,

@@ -35,8 +35,9 @@ def text_package(protocol: Protocol, text: TextFrame) -> dict[str, str]:
 def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Iterator[str]:
     """The virtual device: the spec's `device:` as data for runtime.device's engine, which sends the sentences
     (encoded by the package's codec) and reads requests with its stream parser."""
-    yield HEADER.format(spec=protocol.spec_path)
-    yield f'"""The virtual {one_line(protocol.title)} device of {protocol.spec_path}: `SIMULATOR()` serves it."""'
+    spec = one_line(protocol.spec_path)
+    yield HEADER.format(spec=spec)
+    yield f'"""The virtual {one_line(protocol.title)} device of {spec}: `SIMULATOR()` serves it."""'
     yield ""
     yield "from __future__ import annotations"
     yield ""
@@ -172,13 +173,13 @@ def _group_class(message: TextMessage, repeat: TextRepeat) -> str:
 
 def _attribute(f: TextField, indent: str = "    ") -> Iterator[str]:
     if f.description or f.unit:
-        unit = f" [{f.unit}]" if f.unit else ""
+        unit = f" [{one_line(f.unit)}]" if f.unit else ""
         yield f"{indent}#: {one_line(f.description or f.name.replace('_', ' '))}{unit}"
     yield f"{indent}{f.name}: {_annotation(f)} = None"
 
 
 def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
-    spec = protocol.spec_path
+    spec = one_line(protocol.spec_path)
     yield HEADER.format(spec=spec)
     yield f'"""{one_line(protocol.title)}.'
     yield ""

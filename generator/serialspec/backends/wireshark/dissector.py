@@ -14,6 +14,7 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import layout_codes, runtime_layout
 from serialspec.backends.common.render import render
+from serialspec.backends.common.text import collapse
 from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import counts
 from serialspec.lang.frozen import frozen
@@ -79,6 +80,8 @@ def emit_dissector(protocol: Protocol) -> str:
         "serialspec.backends.wireshark",
         "dissector.lua.j2",
         protocol=protocol,
+        title=collapse(protocol.title),  # Lua comment lines: one line each
+        spec=collapse(protocol.spec_path),
         enums=lua({e.name: _enum_values(e) for e in protocol.enums}, 0),
         tables=lua(tables, 0),
         layouts=lua(shared, 0),
@@ -338,7 +341,11 @@ def _count(count: Count | None) -> int | str | Ref | None:
 
 
 def _fields(fields: tuple[Field, ...]) -> list[dict[str, Any]]:
-    return [_field(item, content_bounds(fields[index + 1 :])[0]) for index, item in enumerate(fields)]
+    tails, tail = [], 0  # the fewest bytes after each field: the later fields' smallest sizes, summed from the end
+    for item in reversed(fields):
+        tails.append(tail)
+        tail += content_bounds((item,))[0]
+    return [_field(item, tail) for item, tail in zip(fields, reversed(tails), strict=True)]
 
 
 def _field(item: Field, tail: int) -> dict[str, Any]:

@@ -8,6 +8,7 @@ from typing import Any
 
 from serialspec.backends import Unsupported
 from serialspec.backends.common.render import render
+from serialspec.backends.common.text import collapse
 from serialspec.backends.common.text_frames import refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
@@ -57,6 +58,8 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         "serialspec.backends.wireshark",
         "text_dissector.lua.j2",
         protocol=protocol,
+        title=collapse(protocol.title),  # Lua comment lines: one line each
+        spec=collapse(protocol.spec_path),
         data=lua(data, 0),
         checksums=checksums,
     )

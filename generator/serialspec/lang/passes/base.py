@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import builtins
 import keyword
+import math
 import re
 import sys
 from dataclasses import field
@@ -40,7 +41,7 @@ LABEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 # --- reserved names: every name generated code uses itself, so that no spec name can shadow one -----------------
 
 # Attribute and parameter names the generated classes and methods use themselves.
-RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self"})
+RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self", "cls"})
 # A field is also a parameter of a client method, whose body has these locals and calls these builtins (a parameter
 # of the same name would shadow them); `id`, a usual address field, is a builtin generated code never calls.
 RESERVED_FIELD_NAMES = (
@@ -377,6 +378,9 @@ class Pass:
         given_low, given_high = given
         if given_low > given_high:
             self.error(path, f"range [{given_low}, {given_high}] is empty")
+        fractions = [b for b in given if isinstance(b, float) and math.isfinite(b) and not b.is_integer()]
+        if fractions and not scalar.is_float:  # a bound between two values: C and Python would round it apart
+            self.error(path, f"range bound {fractions[0]} is no whole number: a {scalar.name} holds whole numbers")
         if given_low < low or given_high > high:
             what = f"{scalar.name} {seven_bit.NAME}" if seven_bits else scalar.name
             self.error(path, f"range [{given_low}, {given_high}] does not fit {what} ({low:g}..{high:g})")

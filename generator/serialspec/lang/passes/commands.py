@@ -17,6 +17,7 @@ from serialspec.lang.model import (
     FrameElement,
     FrameLayout,
     Framing,
+    List,
     Message,
     OptionalWhen,
     Scalar,
@@ -268,7 +269,8 @@ class Commands(FieldResolver):
                     )
 
     def check_request_references(self, commands: list[Command]) -> None:
-        """A response's `after`, `start: request.<field>` and `size_from` name fields of the requests it answers."""
+        """A response's `after`, `start: request.<field>`, `size_from` and `count_from` name fields of the requests it
+        answers."""
         messages = [m for c in commands for m in c.messages()]
         replies = replies_by_request(messages)
         requests = {m.key: m for m in messages if m.direction == Direction.REQUEST}
@@ -293,6 +295,8 @@ class Commands(FieldResolver):
                     wanted.append(((*path, "fields", f.name, "start"), f.start))
                 if isinstance(f, Bytes) and f.size_from:
                     wanted.append(((*path, "fields", f.name, "size_from"), f.size_from))
+                if isinstance(f, List) and f.count_from:
+                    wanted.append(((*path, "fields", f.name, "count_from"), f.count_from))
             for where, name in wanted:
                 if name in self.ctx.broken:
                     continue

@@ -600,7 +600,8 @@ class DevicePass(Pass):
                         self.error(at, f"unknown response field {name!r}: no response carries it")
                     continue
                 for shown, owner in owners:  # a reply value goes to every response that has the field
-                    if bit and bit not in {b.name for b in getattr(owner, "bits", ())}:
+                    bits = owner.bits if isinstance(owner, Scalar | FrameElement) else ()  # a List's bits: a flag
+                    if bit and bit not in {b.name for b in bits or ()}:
                         self.error(at, f"{shown}'s {head} has no bit field {bit!r}")
                     elif not bit and where == ("reply",) and isinstance(owner, Scalar) and owner.bits:
                         bit_names = [b.name for b in owner.bits]

@@ -49,7 +49,8 @@ TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count", "label")
 class FieldResolver(Pass):
     """Resolves a message's fields; the commands pass uses it for every message."""
 
-    later_names: list[str] = []  # the names after the field being resolved, in its content
+    later_names: frozenset[str] = frozenset()  # the names of the content being resolved (a count naming one not
+    # resolved yet names a later field)
 
     def check_rest(self, fields: tuple[Field, ...], path: Path) -> None:
         for field in fields[:-1]:
@@ -61,22 +62,25 @@ class FieldResolver(Pass):
 
     def fields(self, raw: dict[str, Any], path: Path, parent: list[Field] | None) -> tuple[Field, ...]:
         resolved: list[Field] = []
-        names = list(raw)
-        for index, (name, item) in enumerate(raw.items()):
-            self.later_names = names[index + 1 :]  # to tell a later field from an unknown one (counts.resolve)
+        names: set[str] = set()
+        every = frozenset(raw)
+        for name, item in raw.items():
+            self.later_names = every  # to tell a later field from an unknown one (counts.resolve; set each time: a
+            # group's fields, resolved inside this loop, set their own)
             field_path = (*path, name)
             self.name(name, field_path, "field name", RESERVED_FIELD_NAMES, keywords=True)
-            if any(f.name == name for f in resolved):
+            if name in names:
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
             if field is not None:
                 resolved.append(field)
+                names.add(field.name)
         self.check_values(resolved, path)
-        return tuple(self.bit_runs(resolved, path))
+        return tuple(self.bit_runs(resolved, path, complete=len(resolved) == len(raw)))
 
-    def bit_runs(self, fields: list[Field], path: Path) -> list[Field]:
+    def bit_runs(self, fields: list[Field], path: Path, complete: bool = True) -> list[Field]:
         """Each field of a bit run (encodings/bit_run.py) with its place; a run that does not end on a byte boundary
-        is an error at its first field."""
+        is an error at its first field (unless a field is missing, its mistake said: the runs are not known)."""
 
         def bits(f: Field) -> int | None:
             plain = isinstance(f, Scalar) and not (f.type.is_float or f.bits or f.sign_magnitude or f.seven_bit)
@@ -86,7 +90,7 @@ class FieldResolver(Pass):
 
         listed = [(f.name, bits(f), isinstance(f, Scalar) and bit_run.width(f.type.name) is not None) for f in fields]
         runs, problem = bit_run.runs(listed)
-        if problem is not None:
+        if problem is not None and complete:
             self.error((*path, problem[0]), problem[1])
         by_name = {f.name: f for f in fields}
         for run in runs:
@@ -213,7 +217,7 @@ class FieldResolver(Pass):
         return spec
 
     def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
-        later = tuple(self.later_names)
+        later = self.later_names
         spec = self.expand(item, path)
         kind = spec["type"]
         for text_key in TEXT_ONLY_FIELD_KEYS:
@@ -399,7 +403,7 @@ class FieldResolver(Pass):
         path: Path,
         endian: Literal["<", ">"],
         siblings: list[Field],
-        later: tuple[str, ...],
+        later: frozenset[str],
     ) -> List:
         """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
         name = common["name"]
@@ -477,7 +481,9 @@ class FieldResolver(Pass):
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         scalar = self.stored(field_type(spec["type"]), sign_magnitude, (*path, "encoding"))
         if bit_run.width(scalar.name) and (odd := [k for k in ("bits", "flags", "encoding", "endian") if k in spec]):
-            self.error((*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)")
+            raise self.fail(
+                (*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)"
+            )
         seven_bits = spec.get("encoding") == seven_bit.NAME
         if seven_bits and (why := seven_bit.problem(scalar.name, scalar.signed, scalar.is_float)):
             self.error((*path, "encoding"), why)
@@ -489,6 +495,8 @@ class FieldResolver(Pass):
         if value_enum is not None and spec.get("range") is None:
             low, high = enum_span(value_enum, low, high)
         const = spec.get("const")
+        if isinstance(const, bool) or not isinstance(const, int):  # none, or not an integer (the grammar said so)
+            const = None
         if const is not None and not low <= const <= high:
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
         if spec.get("scale") == 0:
@@ -596,7 +604,7 @@ class FieldResolver(Pass):
         siblings: list[Field],
         parent: list[Field] | None,
         path: Path,
-        later: tuple[str, ...],
+        later: frozenset[str],
     ) -> Count:
         """A count or size as given: a number or `rest` as it is; a field's name, that field made derived (encode
         writes the length); an expression over earlier fields, which stay in the message (serialspec/lang/counts.py)."""

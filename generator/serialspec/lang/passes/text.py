@@ -6,8 +6,10 @@ binary frames have yet are refused one line each, so that nothing a spec says is
 
 from __future__ import annotations
 
+import math
 import string
 from dataclasses import replace
+from decimal import Decimal
 from typing import Any, Literal, cast
 
 from serialspec import checksums
@@ -55,6 +57,20 @@ ANSWER_KEYS = ("description", "stores", "sets", "reports", "echoes")
 # not spaces, quotes, backslashes, `*` or `|`, which the outputs' strings, comments and tables would need escaped
 CODE_PUNCTUATION = "$!?~#%&+-./:;=@^_"
 CODE_CHARACTERS = string.ascii_letters + string.digits + CODE_PUNCTUATION
+
+
+# a text number's range bounds: as many significant digits (and fraction digits) as a signed 64-bit integer holds
+DIGITS = 18
+
+
+def _fits_digits(bound: float) -> bool:
+    """Whether a range bound is a decimal of at most DIGITS digits, none of them beyond the DIGITS-th decimal."""
+    if not math.isfinite(bound):
+        return True  # not a number of digits at all: the grammar's line says so
+    number = (Decimal(bound) if isinstance(bound, int) else Decimal(repr(float(bound)))).normalize()
+    exponent = number.as_tuple().exponent
+    assert isinstance(exponent, int)
+    return abs(number) < Decimal(10) ** DIGITS and -exponent <= DIGITS and len(number.as_tuple().digits) <= DIGITS
 
 
 def is_text(data: Any) -> bool:
@@ -422,6 +438,11 @@ class TextPass(Pass):
             if key not in COMMON_KEYS and key not in KIND_KEYS[kind]:
                 self.error((*path, key), f"`{key}` does not apply to a {kind} field in a text frame")
         low, high = (spec.get("range") or (None, None))[:2]
+        if low is not None and high is not None and low > high:
+            self.error((*path, "range"), f"range [{low}, {high}] is empty")
+        for bound in (low, high):
+            if bound is not None and not _fits_digits(bound):
+                self.error((*path, "range"), f"range bound {bound} has more than {DIGITS} digits (C holds 64 bits)")
         letters = tuple((str(label), str(letter)) for label, letter in (spec.get("letters") or {}).items())
         for label, letter in letters:
             self.name(label, (*path, "letters", label), "letter label")

@@ -2199,7 +2199,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             out->kind = HIWONDER_RRC_BUZZER_REQUEST; r = hiwonder_rrc__dec_buzzer_request(c, n, &out->u.buzzer_request);  return r;
         }
         case 3L: {
-            if (n <= 0u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 1u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[0]) {
             case 0u: out->kind = HIWONDER_RRC_MOTOR_SET_SPEED_REQUEST; r = hiwonder_rrc__dec_motor_set_speed_request(c, n, &out->u.motor_set_speed_request);  return r;
             case 1u: out->kind = HIWONDER_RRC_MOTOR_SET_SPEEDS_REQUEST; r = hiwonder_rrc__dec_motor_set_speeds_request(c, n, &out->u.motor_set_speeds_request);  return r;
@@ -2210,7 +2210,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             }
         }
         case 4L: {
-            if (n <= 0u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 1u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[0]) {
             case 1u: out->kind = HIWONDER_RRC_PWM_SERVO_SET_POSITIONS_REQUEST; r = hiwonder_rrc__dec_pwm_servo_set_positions_request(c, n, &out->u.pwm_servo_set_positions_request);  return r;
             case 3u: out->kind = HIWONDER_RRC_PWM_SERVO_SET_POSITION_REQUEST; r = hiwonder_rrc__dec_pwm_servo_set_position_request(c, n, &out->u.pwm_servo_set_position_request);  return r;
@@ -2221,7 +2221,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             }
         }
         case 5L: {
-            if (n <= 0u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 1u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[0]) {
             case 1u: out->kind = HIWONDER_RRC_BUS_SERVO_SET_POSITIONS_REQUEST; r = hiwonder_rrc__dec_bus_servo_set_positions_request(c, n, &out->u.bus_servo_set_positions_request);  return r;
             case 5u: out->kind = HIWONDER_RRC_BUS_SERVO_READ_POSITION_REQUEST; r = hiwonder_rrc__dec_bus_servo_read_position_request(c, n, &out->u.bus_servo_read_position_request);  return r;
@@ -2249,7 +2249,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             out->kind = HIWONDER_RRC_OLED_REQUEST; r = hiwonder_rrc__dec_oled_request(c, n, &out->u.oled_request);  return r;
         }
         case 11L: {
-            if (n <= 0u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 1u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[0]) {
             case 1u: out->kind = HIWONDER_RRC_RGB_SET_PIXELS_REQUEST; r = hiwonder_rrc__dec_rgb_set_pixels_request(c, n, &out->u.rgb_set_pixels_request);  return r;
             default: return HIWONDER_RRC_E_UNKNOWN;
@@ -2260,7 +2260,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
     default: /* HIWONDER_RRC_RESPONSE */
         switch (code) {
         case 4L: {
-            if (n <= 1u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 2u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[1]) {
             case 5u: out->kind = HIWONDER_RRC_PWM_SERVO_READ_POSITION_RESPONSE; r = hiwonder_rrc__dec_pwm_servo_read_position_response(c, n, &out->u.pwm_servo_read_position_response);  return r;
             case 9u: out->kind = HIWONDER_RRC_PWM_SERVO_READ_OFFSET_RESPONSE; r = hiwonder_rrc__dec_pwm_servo_read_offset_response(c, n, &out->u.pwm_servo_read_offset_response);  return r;
@@ -2268,7 +2268,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             }
         }
         case 5L: {
-            if (n <= 1u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 2u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[1]) {
             case 5u: out->kind = HIWONDER_RRC_BUS_SERVO_READ_POSITION_RESPONSE; r = hiwonder_rrc__dec_bus_servo_read_position_response(c, n, &out->u.bus_servo_read_position_response);  return r;
             case 7u: out->kind = HIWONDER_RRC_BUS_SERVO_READ_VOLTAGE_RESPONSE; r = hiwonder_rrc__dec_bus_servo_read_voltage_response(c, n, &out->u.bus_servo_read_voltage_response);  return r;
@@ -2295,7 +2295,7 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
             out->kind = HIWONDER_RRC_SBUS_RESPONSE; r = hiwonder_rrc__dec_sbus_response(c, n, &out->u.sbus_response);  return r;
         }
         case 0L: {
-            if (n <= 0u) { return HIWONDER_RRC_E_LENGTH; }
+            if (n < 1u) { return HIWONDER_RRC_E_LENGTH; }
             switch (c[0]) {
             case 4u: out->kind = HIWONDER_RRC_SYSTEM_BATTERY_RESPONSE; r = hiwonder_rrc__dec_system_battery_response(c, n, &out->u.system_battery_response);  return r;
             default: return HIWONDER_RRC_E_UNKNOWN;

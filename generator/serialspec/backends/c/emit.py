@@ -211,6 +211,16 @@ class Ctx:
         return len(self.checks) - 1
 
 
+def const_wire(f: Scalar) -> int:
+    """A field's constant as the wire bits the C reads and writes (get/put): a negative one in two's complement, or
+    as sign and size (`sign_magnitude`); the C compared -3 with the bits read as -3UL (never equal)."""
+    assert isinstance(f.const, int)
+    bits = 8 * f.type.size
+    if f.const < 0 and f.sign_magnitude:
+        return (1 << (bits - 1)) | -f.const
+    return f.const & ((1 << bits) - 1)
+
+
 # --- what the C target can do --------------------------------------------------------------------------------------
 
 
@@ -219,8 +229,8 @@ def refuse_unsupported(protocol: Protocol) -> None:
     text.refuse)."""
     refuse_by_request(protocol)
     for command in protocol.commands:
-        if command.selector is not None and command.selector.type.size != 1:
-            raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
+        if command.selector is not None and command.selector.type.size > 4:
+            raise Unsupported(f"sub-command selectors of more than four bytes (command {command.name})")
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             refuse_layout(layout)
@@ -640,7 +650,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 if f.const is not None:
                     out.append(
                         f"{pad}if ({get_raw(ctx, f.type, f.endian, 'c + o')} != "
-                        f"{f.const}{'ULL' if wide(f.type) else 'UL'}) {{ return {ctx.P}_E_CONTENT; }}"
+                        f"{const_wire(f)}{'ULL' if wide(f.type) else 'UL'}) {{ return {ctx.P}_E_CONTENT; }}"
                     )
                 elif f.hidden:
                     local = f"d{depth}_{name}"
@@ -1274,7 +1284,7 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Scalar():
                 size = f.type.size
                 if f.const is not None:
-                    value = f"{f.const}{'ULL' if wide(f.type) else 'UL'}"
+                    value = f"{const_wire(f)}{'ULL' if wide(f.type) else 'UL'}"
                 elif f.derived:
                     value = scope.lookup(f.name)
                 elif f.value is not None:

@@ -39,6 +39,7 @@ from serialspec.lang.model import (
     FrameLayout,
     Message,
     Protocol,
+    ScalarType,
     discriminator,
     fixed_bits,
     nul_ended,
@@ -1164,14 +1165,15 @@ def source(ctx: Ctx) -> str:
                     "        }",
                 ]
                 continue
-            if command.selector is not None:  # sub-commands: told apart by the selector byte in the content
-                offset = command.selector.offsets[d]
-                body.append(f"            if (n <= {offset}u) {{ return {P}_E_LENGTH; }}")
-                body.append(f"            switch (c[{offset}]) {{")
+            if command.selector is not None:  # sub-commands: told apart by the selector in the content
+                offset, selector = command.selector.offsets[d], command.selector.type
+                body.append(f"            if (n < {offset + selector.size}u) {{ return {P}_E_LENGTH; }}")
+                body.append(f"            switch ({selector_value(selector, offset, protocol.byte_order)}) {{")
                 for sub in command.subcommands:
                     m = sub.request if d == Direction.REQUEST else sub.response
                     if m is not None:
-                        body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
+                        label = f"{sub.code}u" if not selector.signed else f"{sub.code}"
+                        body.append(f"            case {label}: {dec_call(ctx, m, values)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
             elif (apart := sized_apart(users, code is None and protocol.framing.by_request(d))) and (
@@ -2291,6 +2293,20 @@ def span_decl_all(stuffed: dict[Direction, bool], P: str) -> str:
     if any(stuffed.values()):
         return f"    uint8_t plain[{P}_MAX_FRAME];"
     return "    uint8_t *plain = NULL;"
+
+
+def selector_value(selector: ScalarType, offset: int, byte_order: str) -> str:
+    """The C expression of a sub-command selector read from the content `c` at `offset`: its type's integer in the
+    protocol's byte order (HCI's u16 opcode), built with shifts; a signed one as an int64_t."""
+    if selector.size == 1:
+        return f"(int8_t)c[{offset}]" if selector.signed else f"c[{offset}]"
+    order = range(selector.size) if byte_order == "big" else reversed(range(selector.size))
+    shifts = [(offset + i, 8 * k) for k, i in enumerate(reversed(list(order)))]
+    value = " | ".join(f"((uint32_t)c[{at}] << {shift}u)" if shift else f"(uint32_t)c[{at}]" for at, shift in shifts)
+    if not selector.signed:
+        return f"({value})"
+    sign = 1 << (8 * selector.size - 1)
+    return f"((int64_t)({value}) ^ {sign}) - {sign}"
 
 
 def dec_call(ctx: Ctx, m: Message, values: tuple[tuple[str, object], ...]) -> str:

@@ -197,6 +197,17 @@ def parser(ctx: Ctx) -> str:
             continue;
         }}"""
     small = small_push(ctx, need, keep)
+    tail_copy = (  # (a header of one byte: no tail; a loop to 0 would be -Wtype-limits' "always false")
+        f"""    for (i = 0u; i < {keep}u; i++) {{ /* the tail the scan keeps: it could begin a header */
+        p->buf[i] = data[size - {keep}u + i];
+#if !{P}_PARSER_SMALL
+        p->verdict[i] = 0u;
+#endif
+    }}
+"""
+        if keep
+        else ""
+    )
     run_function, run_call = run_skip(ctx, list(layouts.values()), need, hl)
     return f"""#if {P}_ENABLE_PARSER
 /* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
@@ -414,13 +425,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     }}
     p->errors++;
     p->garbage += (uint32_t)(size - {keep}u);
-    for (i = 0u; i < {keep}u; i++) {{ /* the tail the scan keeps: it could begin a header */
-        p->buf[i] = data[size - {keep}u + i];
-#if !{P}_PARSER_SMALL
-        p->verdict[i] = 0u;
-#endif
-    }}
-    p->n = {keep}u;
+{tail_copy}    p->n = {keep}u;
     return size;
 }}
 #endif

@@ -490,9 +490,13 @@ class Commands(FieldResolver):
                 if message.subcommand is not None:
                     where = (*where, "subcommands", message.subcommand)
                 where = (*where, message.direction.value, "fields")
+                said = [p for p in self.ctx.reported if p[: len(where)] == where]
                 if why := counts.unsized(fields):
-                    self.error((*where, why[0], why[1]), why[2])
+                    if not any(p[: len(where) + 1] == (*where, why[0]) for p in said):  # one mistake, one line
+                        self.error((*where, why[0], why[1]), why[2])
                 elif not sized_by_itself(fields) and (rest := rest_taker(fields)):
+                    if any(p[: len(where) + 1] == (*where, rest[0].name) for p in said):
+                        continue  # its size said wrong already (a `size_from` it could not read): one line
                     self.error(
                         (*where, rest[0].name, rest[1]),
                         f"`{rest[1]}: rest` cannot size a frame that has no length element, trailer or transform: a "

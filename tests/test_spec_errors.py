@@ -82,6 +82,8 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "angle: [i16"), "YAML syntax error"),
         (("angle: i16", "angle: {type: group, count: n, fields: {x: u8}}"), "unknown field 'n'"),
         (("angle: i16", "data: {type: bytes, size: rest}\n        after: u8"), "only the last field"),
+        (("angle: i16", "name: {type: string, size: rest}\n        after: u8"), "only the last field"),
+        (("angle: i16", "items: {type: array, of: u8, count: rest}\n        after: u8"), "only the last field"),
         (("angle: i16", 'n: {type: u8, value: "2 * m"}'), "unknown field 'm' in '2 * m'"),
         (("angle: i16", 'n: {type: u8, value: "2 ** servo_id"}'), "'2 ** servo_id' is not allowed"),
         (("angle: i16", 'n: {type: u8, value: "len(servo_id)"}'), "servo_id is not a list"),

@@ -226,6 +226,9 @@ from serialspec.lang.model.sizes import (
 from serialspec.lang.model.sizes import (
     sum_sizes as sum_sizes,
 )
+from serialspec.lang.model.sizes import (
+    takes_rest as takes_rest,
+)
 from serialspec.lang.model.text_frames import (
     TextAnswer as TextAnswer,
 )

@@ -193,16 +193,24 @@ def nul_ended(fields: tuple[Field, ...]) -> int | None:
     return None if any(size is None for size in sizes) else sum(size or 0 for size in sizes)
 
 
+def takes_rest(field: Field) -> str | None:
+    """The key by which a field takes the rest of its content (`size: rest`, `count: rest`), or None."""
+    match field:
+        case Bytes() | Text() if field.size == "rest":
+            return "size"
+        case List() | Group() if field.count == "rest":
+            return "count"
+        case _:
+            return None
+
+
 def rest_taker(fields: tuple[Field, ...]) -> tuple[Field, str] | None:
-    """The field that takes the rest of the content (`size: rest`, `count: rest`) and its key, where nothing else
-    tells its size (a response's bytes `size_from` a request field are sized by the request)."""
+    """The field that takes the rest of the content and its key, where nothing else tells its size (a response's
+    bytes `size_from` a request field are sized by the request)."""
     for field in fields:
-        if isinstance(field, Bytes) and field.size == "rest" and not field.size_from:
-            return field, "size"
-        if isinstance(field, Text) and field.size == "rest":
-            return field, "size"
-        if isinstance(field, List | Group) and field.count == "rest":
-            return field, "count"
+        key = takes_rest(field)
+        if key is not None and not (isinstance(field, Bytes) and field.size_from):
+            return field, key
     return None
 
 

@@ -26,6 +26,7 @@ from serialspec.lang.model import (
     TableValue,
     Text,
     sum_sizes,
+    takes_rest,
 )
 from serialspec.lang.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
 from serialspec.runtime.hexbytes import parse_hex
@@ -54,10 +55,7 @@ class FieldResolver(Pass):
 
     def check_rest(self, fields: tuple[Field, ...], path: Path) -> None:
         for field in fields[:-1]:
-            takes_rest = (isinstance(field, Bytes) and field.size == "rest") or (
-                isinstance(field, Group) and field.count == "rest"
-            )
-            if takes_rest:
+            if takes_rest(field):
                 self.error((*path, field.name), "only the last field can take the rest of the content")
 
     def fields(self, raw: dict[str, Any], path: Path, parent: list[Field] | None) -> tuple[Field, ...]:

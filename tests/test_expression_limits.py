@@ -121,3 +121,21 @@ def test_a_divisor_of_zero_from_the_wire_is_a_decode_error() -> None:
             package.decode(frame, "request")
         with pytest.raises(EncodeError):
             package.encode(package.messages.MoveRequest(id=1, angle=0, mode=0, time=5))
+
+
+@settings(max_examples=examples(50), deadline=None)
+@given(EXPRESSIONS)
+def test_an_expression_is_shown_as_it_reads(text: str) -> None:
+    """What docs and error lines show of an expression reads back as the same expression, a minus sign as one."""
+    try:
+        parsed = expression.parse(text)
+    except expression.ExpressionError:
+        return
+    shown = expression.show(parsed)
+    assert expression.parse(shown) == parsed, shown
+    assert "(0 - " not in shown, shown
+
+
+def test_a_minus_sign_is_shown_as_written() -> None:
+    assert expression.show(expression.parse("-200 + n")) == "-200 + n"
+    assert expression.show(expression.parse("-(a + b) * 2")) == "-(a + b) * 2"

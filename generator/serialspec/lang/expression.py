@@ -238,6 +238,9 @@ def show(expr: Expr) -> str:
         return expr.name
     if isinstance(expr, Length):
         return f"len({expr.name})"
+    if _negation(expr):
+        assert isinstance(expr, BinOp)
+        return f"-({show(expr.right)})" if isinstance(expr.right, BinOp) else f"-{show(expr.right)}"
     if isinstance(expr, BinOp):
         return f"{_operand(expr.left)} {expr.op} {_operand(expr.right)}"
     if isinstance(expr, Invert):
@@ -248,7 +251,13 @@ def show(expr: Expr) -> str:
 
 
 def _operand(expr: Expr) -> str:
-    return f"({show(expr)})" if isinstance(expr, BinOp) else show(expr)
+    return f"({show(expr)})" if isinstance(expr, BinOp) and not _negation(expr) else show(expr)
+
+
+def _negation(expr: Expr) -> bool:
+    """Whether the expression is a minus sign (`-x`, which parse() reads as `0 - x`): it binds tighter than every
+    operator, so it needs no parentheses."""
+    return isinstance(expr, BinOp) and expr.op == "-" and expr.left == Const(0)
 
 
 def evaluate(expr: Expr, values: Mapping[str, object]) -> int:

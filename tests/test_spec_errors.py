@@ -165,6 +165,11 @@ def test_a_misspelt_role_is_one_line_not_one_more_per_key_of_the_role(tmp_path: 
     assert errors_of(tmp_path, MINIMAL.replace("role: content}", "role: content, adds: 1}")) == [
         "tiny.yaml:10:36: framing.elements.content.adds: `adds` belongs to a length element"
     ]
+    # `algorithm: sum8` was said unknown, then the checksum was said to need an algorithm
+    misspelt = errors_of(tmp_path, MINIMAL.replace("algorithm: sum,", "algorithm: sum8,"))
+    assert len(misspelt) == 1 and "checksum.algorithm: unknown value 'sum8'" in misspelt[0], misspelt
+    missing = errors_of(tmp_path, MINIMAL.replace("algorithm: sum,", ""))
+    assert len(missing) == 1 and "framing.elements.checksum: a checksum needs `algorithm: crc`" in missing[0], missing
 
 
 def test_an_error_flag_with_a_command_code_that_is_not_a_number_is_an_error_line(tmp_path: Path) -> None:

@@ -46,7 +46,8 @@ def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report)
     if name not in found:
         names = list(found)
         choices = ", ".join(f"`algorithm: {n}`" for n in names[:-1]) + f" or `algorithm: {names[-1]}`"
-        raise ChecksumProblem((), f"a checksum needs {choices}")
+        # at the key when one is given (the grammar has said it is none of these: one mistake, one line)
+        raise ChecksumProblem(("algorithm",) if "algorithm" in raw else (), f"a checksum needs {choices}")
     for key, owners in owned_keys().items():
         if key in raw and name not in owners:
             report((key,), f"`{key}` belongs to `algorithm: {' or '.join(owners)}`, not {name}")

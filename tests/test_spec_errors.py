@@ -83,6 +83,12 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "angle: {type: group, count: n, fields: {x: u8}}"), "unknown field 'n'"),
         (("angle: i16", "data: {type: bytes, size: rest}\n        after: u8"), "only the last field"),
         (("angle: i16", "name: {type: string, size: rest}\n        after: u8"), "only the last field"),
+        (("angle: i16", "data: {type: bytes, size: 9223372036854775807}"), "more than a field can hold"),
+        (("angle: i16", "v: {type: array, of: u64, count: 268435456}"), "2147483648 bytes: more than a field"),
+        (
+            ("angle: i16", "a: {type: bytes, size: 1500000000}\n        b: {type: bytes, size: 1500000000}"),
+            "fields: at least 3000000001 bytes: more than a content can hold",
+        ),
         (("angle: i16", "items: {type: array, of: u8, count: rest}\n        after: u8"), "only the last field"),
         (("angle: i16", 'n: {type: u8, value: "2 * m"}'), "unknown field 'm' in '2 * m'"),
         (("angle: i16", 'n: {type: u8, value: "2 ** servo_id"}'), "'2 ** servo_id' is not allowed"),

@@ -463,7 +463,8 @@ _FIELD_LONG: dict[str, Shape] = {
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf(
         (Int(), Str()),
-        "bytes, string: a number, `rest` (up to the end of the content; a frame that has no length element, trailer "
+        "bytes, string: a number (a field or a content of a fixed size holds at most 2147483647 bytes, 2^31 - 1), "
+        "`rest` (up to the end of the content; a frame that has no length element, trailer "
         "or transform cannot end that way: a stream parser could not tell where, so it is refused) or the name of "
         "an earlier integer field, "
         "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "

@@ -206,6 +206,9 @@ from serialspec.lang.model.protocol import (
     Protocol as Protocol,
 )
 from serialspec.lang.model.sizes import (
+    MAX_FIXED_SIZE as MAX_FIXED_SIZE,
+)
+from serialspec.lang.model.sizes import (
     byte_size_expression as byte_size_expression,
 )
 from serialspec.lang.model.sizes import (

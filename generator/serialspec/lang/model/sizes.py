@@ -184,6 +184,11 @@ def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, st
     return fixed, tuple(terms)
 
 
+#: The most bytes a field or a content may have for certain (its fixed size, its least): more is a mistake in a
+#: spec for a serial line, and no 32-bit C size_t or Python struct could hold it.
+MAX_FIXED_SIZE = 2**31 - 1
+
+
 def nul_ended(fields: tuple[Field, ...]) -> int | None:
     """The offset of a content's NUL-terminated text where fixed fields come before it and nothing after it
     (RoboClaw's version string, in a frame that carries no length): its size is then told by its NUL."""

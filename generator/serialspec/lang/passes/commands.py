@@ -10,6 +10,7 @@ from serialspec.lang import counts, expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
+    MAX_FIXED_SIZE,
     Bytes,
     Command,
     Direction,
@@ -677,6 +678,8 @@ class Commands(FieldResolver):
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
+        if low > MAX_FIXED_SIZE and all((fixed_size(f) or 0) <= MAX_FIXED_SIZE for f in fields):  # else said per field
+            self.error((*path, "fields"), f"at least {low} bytes: more than a content can hold ({MAX_FIXED_SIZE})")
         padded = None
         if framing is not None and framing.layouts[direction].truncates and high != 0:
             if low != high:

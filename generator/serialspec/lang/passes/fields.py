@@ -10,6 +10,7 @@ from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import counts, expression, grammar
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
+    MAX_FIXED_SIZE,
     SCALARS,
     Array,
     BitField,
@@ -25,6 +26,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    fixed_size,
     sum_sizes,
     takes_rest,
 )
@@ -70,6 +72,8 @@ class FieldResolver(Pass):
             if name in names:
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
+            if field is not None and (fixed_size(field) or 0) > MAX_FIXED_SIZE:
+                self.error(field_path, f"{fixed_size(field)} bytes: more than a field can hold ({MAX_FIXED_SIZE})")
             if field is not None:
                 resolved.append(field)
                 names.add(field.name)

@@ -316,6 +316,16 @@ def test_many_mistakes_show_the_first_50_and_count_the_rest(tmp_path: Path) -> N
         assert "... and 29 more errors (79 in all)" in result.stderr.splitlines(), verb
 
 
+def test_an_unknown_name_among_thousands_lists_a_dozen_and_counts_the_rest(tmp_path: Path) -> None:
+    """An unknown enum in a spec of 3,000 enums listed all 3,000 names in its one line."""
+    enums = "".join(f"  e{i}: {{values: {{a: 1}}}}\n" for i in range(3000))
+    lines = errors_of(tmp_path, MINIMAL.replace("angle: i16", "angle: {type: u8, enum: colours}") + "enums:\n" + enums)
+    assert lines == [
+        "tiny.yaml:19:33: commands.move.request.fields.angle.enum: unknown enum 'colours' (expected one of: e0, e1, "
+        "e2, e3, e4, e5, e6, e7, e8, e9, e10, e11 and 2988 more)"
+    ], lines
+
+
 def load_errors(tmp_path: Path, text: str) -> SpecErrors:
     spec = tmp_path / "tiny.yaml"
     spec.write_text(text, encoding="utf-8")

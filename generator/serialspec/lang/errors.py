@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from serialspec.lang.frozen import frozen
 
@@ -20,6 +20,21 @@ class SpecError:
         line = f"{self.file}:{self.line}:{self.column}: {where}{self.message}"
         # one line whatever the file's name or the text quoted: anything unprintable (a newline) escaped
         return line if line.isprintable() else "".join(c if c.isprintable() else f"\\x{ord(c):02x}" for c in line)
+
+
+#: How many names an error line lists (the names a spec defines, when it names another): the rest are counted.
+MAX_NAMES = 12
+
+
+def listed(names: Iterable[str], empty: str = "none defined") -> str:
+    """Names for an error line: the names, or the first MAX_NAMES and a count of the others (a spec of thousands
+    of commands gives a line, not a page); `empty` where there are none."""
+    every = list(names)
+    if not every:
+        return empty
+    if len(every) <= MAX_NAMES:
+        return ", ".join(every)
+    return f"{', '.join(every[:MAX_NAMES])} and {len(every) - MAX_NAMES} more"
 
 
 #: How many mistakes str(SpecErrors) shows, in file order; a last line counts the rest.

@@ -16,7 +16,7 @@ from typing import Any, Literal
 
 from serialspec.encodings import seven_bit
 from serialspec.lang import grammar
-from serialspec.lang.errors import SpecError
+from serialspec.lang.errors import SpecError, listed
 from serialspec.lang.frozen import mutable
 from serialspec.lang.loader import Located, Path, dotted
 from serialspec.lang.model import (
@@ -332,7 +332,7 @@ class Pass:
         if value not in registry:
             if value in self.ctx.broken:
                 raise Bad  # defined, but it failed to resolve: its own problem is reported
-            known = ", ".join(registry) or "none defined"
+            known = listed(registry)
             raise self.fail(path, f"unknown {kind} {value!r} (expected one of: {known})")
         return registry[value]
 

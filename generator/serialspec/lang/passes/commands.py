@@ -7,7 +7,7 @@ from typing import Any, Literal
 
 from serialspec.checksums.seed import Seeded
 from serialspec.lang import counts, expression
-from serialspec.lang.errors import SpecError
+from serialspec.lang.errors import SpecError, listed
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     MAX_FIXED_SIZE,
@@ -285,7 +285,7 @@ class Commands(FieldResolver):
                 continue
             path = message_path(message)
             if message.answers and message.answers not in requests:
-                known = ", ".join(requests) or "none"
+                known = listed(requests, "none")
                 self.error((*path, "answers"), f"unknown request {message.answers!r} (expected one of: {known})")
             asked = answered.get(message.key, [])
             wanted: list[tuple[Path, str]] = []
@@ -303,7 +303,7 @@ class Commands(FieldResolver):
                     continue
                 if not any(integer_field(r, name) for r in asked):
                     names = sorted({f.name for r in asked for f in r.fields if isinstance(f, Scalar)})
-                    known = ", ".join(names) or "none"
+                    known = listed(names, "none")
                     self.error(
                         where,
                         f"no request this response answers has an integer field {name!r} (they have: {known})",

@@ -6,7 +6,7 @@ from collections.abc import Container, Mapping
 from typing import Any
 
 from serialspec.lang import expression
-from serialspec.lang.errors import SpecError
+from serialspec.lang.errors import SpecError, listed
 from serialspec.lang.expression import Expr
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -923,7 +923,7 @@ class DevicePass(Pass):
         if default is not None:
             found = next((m for m in models if m.name == default), None)
             if found is None:
-                known = ", ".join(m.name for m in models) or "none defined"
+                known = listed([m.name for m in models])
                 self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
             else:
                 models.remove(found)

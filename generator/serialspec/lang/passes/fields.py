@@ -8,6 +8,7 @@ from typing import Any, Literal
 
 from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang import counts, expression, grammar
+from serialspec.lang.errors import listed
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     MAX_FIXED_SIZE,
@@ -211,7 +212,7 @@ class FieldResolver(Pass):
         if "use" in spec:
             base_name = spec.pop("use")
             if base_name not in self.shared_fields:
-                known = ", ".join(self.shared_fields) or "none defined"
+                known = listed(self.shared_fields)
                 raise self.fail((*path, "use"), f"unknown shared field {base_name!r} (expected one of: {known})")
             spec = {**self.expand(self.shared_fields[base_name], ("fields", base_name)), **spec}
         if "type" not in spec:

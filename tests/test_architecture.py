@@ -9,6 +9,7 @@ that file exists, else to the package.
 from __future__ import annotations
 
 import ast
+from functools import cache
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent / "generator"
@@ -50,6 +51,7 @@ def imports(path: Path, name: str, known: dict[str, Path]) -> set[str]:
     return {target for target in found if target in known and target != name}
 
 
+@cache  # two tests read it: the package is parsed once
 def graph() -> dict[str, set[str]]:
     known = modules()
     return {name: imports(path, name, known) for name, path in known.items()}

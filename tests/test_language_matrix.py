@@ -1190,14 +1190,18 @@ CASES[MIXED] = Case(
 )
 
 # Layouts chosen by command with frame values of their own (RPLIDAR: the response descriptor's size and mode beside
-# headerless measurements that carry none): each message carries its own layout's values
+# headerless measurements that carry none; HCI's ACL handle and flags beside commands and events that carry none):
+# each message carries its own layout's values (the C: its own layout's, in its struct and the engine's values[])
 OWN_VALUES = "frame: layouts chosen by command, a frame value one layout has and another has not"
 CASES[OWN_VALUES] = copy.deepcopy(CASES[MIXED])
 _data = CASES[OWN_VALUES].framing["layouts"]["data"]["elements"]
 _data["seq"] = {"role": "value", "type": "u8", "range": [0, 99]}
 _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
-C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
+_config = CASES[OWN_VALUES].framing["layouts"]["config"]["elements"]
+_config["handle"] = {"role": "value", "type": "u16", "bits": {"link": {"bits": [11, 0]}, "kind": {"bits": [15, 12]}}}
+_config["content"] = _config.pop("content")
+_config["code"] = _config.pop("code")
 
 # A length counting the whole frame, from the header before it (Benewake TFmini Plus: 5A, the frame's length, ...)
 CASES["frame: a length counting from the header before it"] = Case(

@@ -14,7 +14,8 @@
 #define NMEA0183__DECODES(dir) ((dir) == NMEA0183_REQUEST ? NMEA0183_DECODES_REQUESTS : (dir) == NMEA0183_RESPONSE && NMEA0183_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says (`$`, the talker id and the sentence id (GPGGA), each field after a comma, then `*` and the XOR of every character between `$` and `*` as two upper-case hex digits, then CR LF; at most 82 characters (gpsd: "NMEA Revealed"). NMEA 0183 makes the checksum optional for some sentences, so a sentence without one is accepted unchecked.) ---- */
-#define NMEA0183__START 0x24u            /* '$' */
+#define NMEA0183__S 1u /* the start character's bytes: 1, or 0 where every line is a frame */
+#define NMEA0183__START 0x24u /* '$' */
 #define NMEA0183__SEPARATOR 0x2Cu    /* ',' */
 #define NMEA0183__MARKER 0x2Au          /* '*': the checksum follows */
 #define NMEA0183__CHECKED 1            /* a checksum is written */
@@ -482,18 +483,20 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
     if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
         end = len - (sizeof(nmea0183__end) - 1u);
     }
+#if NMEA0183__S
     if (end < 1u || f[0] != NMEA0183__START) {
         return NMEA0183_E_FRAME;
     }
+#endif
     stop = end;
 #if NMEA0183__CHECKED
     {
         size_t at = end, k;
         uint32_t written = 0u;
-        while (at > 1u && f[at - 1u] != NMEA0183__MARKER) {
+        while (at > NMEA0183__S && f[at - 1u] != NMEA0183__MARKER) {
             at--;
         }
-        if (at > 1u) {
+        if (at > NMEA0183__S) {
             if (end - at != NMEA0183__DIGITS) {
                 return NMEA0183_E_CHECKSUM;
             }
@@ -505,7 +508,7 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
                 written = (written << 4) | (uint32_t)v;
             }
             stop = at - 1u;
-            if (written != nmea0183__checksum(f + 1u, stop - 1u)) {
+            if (written != nmea0183__checksum(f + NMEA0183__S, stop - NMEA0183__S)) {
                 return NMEA0183_E_CHECKSUM;
             }
         } else if (NMEA0183__REQUIRED) {
@@ -515,19 +518,19 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
         }
     }
 #endif
-    *body = 1u;
-    *n = stop - 1u;
+    *body = NMEA0183__S;
+    *n = stop - NMEA0183__S;
     return NMEA0183_OK;
 }
 #endif
 
 #if NMEA0183_ENABLE_ENCODE
-/* Exactly `sent` fields after the address (o->b[1..n): the address, then each field after a separator): the fields
+/* Exactly `sent` fields after the address (o->b[NMEA0183__S..n): the address, then each field after a separator): the fields
  * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. */
 static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 {
     size_t i, k, fields = 0u;
-    for (i = 1u; i < o->n; i++) {
+    for (i = NMEA0183__S; i < o->n; i++) {
         if (o->b[i] == NMEA0183__SEPARATOR && ++fields > sent) {
             break;
         }
@@ -547,16 +550,18 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
     return NMEA0183_OK;
 }
 
-/* The frame around fields already written from buf[1]: the start before them, checksum (unless `unchecked`: a
+/* The frame around fields already written from buf[NMEA0183__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
 static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked)
 {
     size_t k;
+#if NMEA0183__S
     o->b[0] = NMEA0183__START;
+#endif
     (void)unchecked;
 #if NMEA0183__CHECKED
     if (!unchecked || NMEA0183__REQUIRED) {
-        uint32_t sum = nmea0183__checksum(o->b + 1u, o->n - 1u);
+        uint32_t sum = nmea0183__checksum(o->b + NMEA0183__S, o->n - NMEA0183__S);
         nmea0183__put(o, NMEA0183__MARKER);
         for (k = NMEA0183__DIGITS; k > 0u; k--) {
             uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
@@ -1955,24 +1960,27 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
     }
 }
 
-void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
-{
-    parser->dir = dir;
-    parser->n = 0u;
-    parser->frames = 0u;
-    parser->garbage = 0u;
-    parser->errors = 0u;
-    parser->unknown = 0u;
-    parser->frame = NULL;
-    parser->frame_len = 0u;
-}
-
 void nmea0183_parser_gap(nmea0183_parser_t *parser)
 {
     if (parser->n > 0u) { /* it begins with the start character */
         parser->errors++;
     }
     parser->n = 0u;
+}
+
+void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
+{
+    parser->dir = dir;
+    parser->n = 0u;
+#if !NMEA0183__S
+    parser->overlong = 0u;
+#endif
+    parser->frames = 0u;
+    parser->garbage = 0u;
+    parser->errors = 0u;
+    parser->unknown = 0u;
+    parser->frame = NULL;
+    parser->frame_len = 0u;
 }
 
 size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size_t len, nmea0183_msg_t *out, bool *got)
@@ -2047,7 +2055,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
     }
     o.b = buf;
     o.cap = cap;
-    o.n = 1u;
+    o.n = NMEA0183__S;
     o.full = 0;
     r = nmea0183__body(msg, &o, 1);
     if (r != NMEA0183_OK) {

@@ -18,8 +18,10 @@ from serialspec.backends.c.text_runtime import (
     CHECKED_READ,
     CHECKED_WRITE,
     HEAD,
+    LINES_PUSH,
     MIDDLE,
     PARSER,
+    START_PUSH,
     Piece,
     used,
     written,
@@ -33,7 +35,7 @@ RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "
 
 def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
-    refuse_text_frames(text)
+    refuse_text_frames(text, lines=True)
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")
@@ -138,6 +140,11 @@ class TextC:
                 f"/* The checksum of the characters between start and marker. */\n{t.checksum.c_code(p).prototype}\n"
             )
         results = ",\n".join(f"    {P}_{r}" + (" = 0" if r == "OK" else "") for r in RESULTS)
+        overlong = (
+            ""
+            if t.start
+            else "    uint8_t overlong; /* frames without a start: the line being read was dropped as too long */\n"
+        )
         return f"""{banner(self.protocol)}
 #ifndef {P}_H
 #define {P}_H
@@ -240,7 +247,7 @@ typedef struct {{
     {p}_direction_t dir;
     size_t n;
     uint8_t buf[{self.limit + 1}u];
-    uint32_t frames;
+{overlong}    uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
     uint32_t unknown; /* of those, frames with a good checksum and an unknown code ({P}_EVENT_FRAME_UNKNOWN) */
@@ -449,7 +456,7 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
         end = ", ".join(_byte(c) for c in t.end)
-        special_characters = sorted({t.start, t.separator, t.marker, *t.end})
+        special_characters = sorted({t.start, t.separator, t.marker, *t.end} - {""})
         checked = t.checksum is not None
         checksum, reflects = "", False
         if t.checksum is not None:
@@ -546,7 +553,8 @@ static int {p}__special(uint8_t c)
         parts = (
             [*HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
         )
-        helpers = used([special, *parts, PARSER], self.calls)
+        push = START_PUSH if t.start else LINES_PUSH  # frames without a start character: every line a frame
+        helpers = used([special, *parts, push, PARSER], self.calls)
 
         def prefixed(pieces: list[Piece]) -> str:
             return written(pieces, helpers).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
@@ -554,7 +562,7 @@ static int {p}__special(uint8_t c)
         runtime = prefixed(parts)
         # the firmware API beside the parser (parser_api.py), inside the parser's feature switch: before its last
         # #endif (the others close role checks inside functions)
-        body, closing, _ = prefixed([PARSER]).rpartition("}\n#endif\n")
+        body, closing, _ = prefixed([push, PARSER]).rpartition("}\n#endif\n")
         assert closing, "the parser piece ends its feature switch"
         parser = (
             body
@@ -566,6 +574,8 @@ static int {p}__special(uint8_t c)
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
+        start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
+        room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
 #include "{p}.h"
 
@@ -578,8 +588,8 @@ static int {p}__special(uint8_t c)
 #define {P}__DECODES(dir) ((dir) == {P}_REQUEST ? {P}_DECODES_REQUESTS : (dir) == {P}_RESPONSE && {P}_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says ({comment(t.description or "")}) ---- */
-#define {P}__START {_byte(t.start)}            /* {comment(repr(t.start))} */
-#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
+#define {P}__S {len(t.start)}u /* the start character's bytes: 1, or 0 where every line is a frame */
+{start}#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
 #define {P}__MARKER {_byte(t.marker)}          /* {comment(repr(t.marker))}: the checksum follows */
 #define {P}__CHECKED {int(checked)}            /* a checksum is written */
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
@@ -736,12 +746,9 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
         return {P}_E_ARG;
     }}
 {talker_check}
-    if (cap < 1u) {{
-        return {P}_E_BUFFER;
-    }}
-    o.b = buf;
+{room}    o.b = buf;
     o.cap = cap;
-    o.n = 1u;
+    o.n = {P}__S;
     o.full = 0;
     r = {p}__body(msg, &o, 1);
     if (r != {P}_OK) {{

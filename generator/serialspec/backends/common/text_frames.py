@@ -7,9 +7,10 @@ from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
 
-def refuse_text_frames(text: TextFrame) -> None:
-    """Unsupported naming the first text feature neither the C nor the Wireshark target generates."""
-    if not text.start:
+def refuse_text_frames(text: TextFrame, lines: bool = False) -> None:
+    """Unsupported naming the first text feature neither the C nor the Wireshark target generates; `lines`: the
+    target reads frames without a start character (every line a frame: the C does)."""
+    if not text.start and not lines:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end):
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")

@@ -32,10 +32,18 @@ from test_text_frames import sentence_values
 pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
 
 MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
-# frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), ended by CR LF
+# frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), ended by CR LF; an
+# optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`)
 LINES = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_lines"}
 del LINES["framing"]["start"]
 LINES["framing"]["end"] = "\r\n"
+LINES["framing"]["checksum"] = {
+    "algorithm": "xor",
+    "format": "decimal",
+    "marker": "*",
+    "required": False,
+    "separated": ["request"],
+}
 CASES = {"c_text_matrix": MATRIX, "c_text_lines": LINES}
 SPECS = {
     "nmea0183": ROOT / "specs" / "nmea0183.yaml",

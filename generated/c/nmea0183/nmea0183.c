@@ -21,6 +21,7 @@
 #define NMEA0183__CHECKED 1            /* a checksum is written */
 #define NMEA0183__REQUIRED 0        /* a frame without one is refused */
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
+#define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
 #define NMEA0183__LIMIT 84u /* the parser drops a line longer than this without its line ending */
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_ENCODE || NMEA0183_ENABLE_PARSER
 static const uint8_t nmea0183__end[] = {0x0Du, 0x0Au, 0x00u}; /* '\r\n', the line ending */
@@ -470,11 +471,13 @@ static int nmea0183__hex_value(uint8_t c)
 }
 
 /* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; NMEA0183_E_FRAME,
- * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
-static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
+ * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
+ * separator before the marker, it is no part of the fields. */
+static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
     *unchecked = 0;
+    (void)dir;
     for (i = 0u; i < len; i++) {
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
@@ -510,6 +513,9 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
             stop = at - 1u;
             if (written != nmea0183__checksum(f + NMEA0183__S, stop - NMEA0183__S)) {
                 return NMEA0183_E_CHECKSUM;
+            }
+            if (NMEA0183__SEPARATED(dir) && stop > NMEA0183__S && f[stop - 1u] == NMEA0183__SEPARATOR) {
+                stop--; /* the separator before the marker, covered by the checksum */
             }
         } else if (NMEA0183__REQUIRED) {
             return NMEA0183_E_CHECKSUM;
@@ -552,16 +558,21 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[NMEA0183__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked)
+static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated)
 {
     size_t k;
+    (void)separated;
 #if NMEA0183__S
     o->b[0] = NMEA0183__START;
 #endif
     (void)unchecked;
 #if NMEA0183__CHECKED
     if (!unchecked || NMEA0183__REQUIRED) {
-        uint32_t sum = nmea0183__checksum(o->b + NMEA0183__S, o->n - NMEA0183__S);
+        uint32_t sum;
+        if (separated) { /* the separator before the marker, covered by the checksum */
+            nmea0183__put(o, NMEA0183__SEPARATOR);
+        }
+        sum = nmea0183__checksum(o->b + NMEA0183__S, o->n - NMEA0183__S);
         nmea0183__put(o, NMEA0183__MARKER);
         for (k = NMEA0183__DIGITS; k > 0u; k--) {
             uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
@@ -1133,7 +1144,7 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
-    r = nmea0183__unframe(frame, len, &body, &n, &unchecked);
+    r = nmea0183__unframe(frame, len, dir, &body, &n, &unchecked);
     if (r != NMEA0183_OK) {
         return r;
     }
@@ -2067,7 +2078,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
             return r;
         }
     }
-    return nmea0183__frame(&o, len, msg->unchecked);
+    return nmea0183__frame(&o, len, msg->unchecked, 0);
 }
 #endif
 

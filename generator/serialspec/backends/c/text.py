@@ -17,6 +17,8 @@ from serialspec.backends.c.text_runtime import (
     BEFORE_PARSER,
     CHECKED_READ,
     CHECKED_WRITE,
+    DECIMAL_CHECKED_READ,
+    DECIMAL_CHECKED_WRITE,
     HEAD,
     LINES_PUSH,
     MIDDLE,
@@ -26,7 +28,7 @@ from serialspec.backends.c.text_runtime import (
     used,
     written,
 )
-from serialspec.backends.common.text_frames import refuse_text_frames
+from serialspec.backends.common.text_frames import C_TAKES, refuse_text_frames
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
@@ -35,7 +37,7 @@ RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "
 
 def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
-    refuse_text_frames(text, lines=True)
+    refuse_text_frames(text, C_TAKES)
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")
@@ -550,9 +552,9 @@ static int {p}__special(uint8_t c)
 """,
             "special",
         )
-        parts = (
-            [*HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
-        )
+        decimal = t.checksum_format == "decimal"  # written in decimal (G-code's `*71`), not as hex digits
+        read, write = (DECIMAL_CHECKED_READ, DECIMAL_CHECKED_WRITE) if decimal else (CHECKED_READ, CHECKED_WRITE)
+        parts = [*HEAD, read, MIDDLE, write, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
         push = START_PUSH if t.start else LINES_PUSH  # frames without a start character: every line a frame
         helpers = used([special, *parts, push, PARSER], self.calls)
 
@@ -574,6 +576,10 @@ static int {p}__special(uint8_t c)
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
+        separated = [m for m in t.messages if m.direction.value in t.checksum_separated]
+        separated_dirs = " || ".join(f"(dir) == {P}_{d.upper()}" for d in t.checksum_separated)
+        separated_dirs = f"({separated_dirs})" if separated_dirs else "0"
+        separated_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in separated) or "0"
         start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
         room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
@@ -594,6 +600,7 @@ static int {p}__special(uint8_t c)
 #define {P}__CHECKED {int(checked)}            /* a checksum is written */
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
+#define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
 #define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
 #if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
 static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
@@ -655,7 +662,7 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}
-    r = {p}__unframe(frame, len, &body, &n, &unchecked);
+    r = {p}__unframe(frame, len, dir, &body, &n, &unchecked);
     if (r != {P}_OK) {{
         return r;
     }}
@@ -760,7 +767,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
             return r;
         }}
     }}
-    return {p}__frame(&o, len, msg->unchecked);
+    return {p}__frame(&o, len, msg->unchecked, {separated_kinds});
 }}
 #endif
 

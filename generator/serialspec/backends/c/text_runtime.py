@@ -641,11 +641,13 @@ static double pfx__angle_value(const pfx_angle_t *a)
     ),
     Piece(
         r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
- * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
-static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
+ * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
+ * separator before the marker, it is no part of the fields. */
+static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
     *unchecked = 0;
+    (void)dir;
     for (i = 0u; i < len; i++) {
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
@@ -667,7 +669,7 @@ static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, i
 )
 
 # the checksum read and written where the protocol has one (text.py leaves them out otherwise)
-CHECKED_READ = Piece(
+_CHECKED_READ = Piece(
     r"""#if PFX__CHECKED
     {
         size_t at = end, k;
@@ -676,19 +678,12 @@ CHECKED_READ = Piece(
             at--;
         }
         if (at > PFX__S) {
-            if (end - at != PFX__DIGITS) {
-                return PFX_E_CHECKSUM;
-            }
-            for (k = at; k < end; k++) {
-                int v = pfx__hex_value(f[k]);
-                if (v < 0) {
-                    return PFX_E_CHECKSUM;
-                }
-                written = (written << 4) | (uint32_t)v;
-            }
-            stop = at - 1u;
+@DIGITS_READ@            stop = at - 1u;
             if (written != pfx__checksum(f + PFX__S, stop - PFX__S)) {
                 return PFX_E_CHECKSUM;
+            }
+            if (PFX__SEPARATED(dir) && stop > PFX__S && f[stop - 1u] == PFX__SEPARATOR) {
+                stop--; /* the separator before the marker, covered by the checksum */
             }
         } else if (PFX__REQUIRED) {
             return PFX_E_CHECKSUM;
@@ -700,6 +695,30 @@ CHECKED_READ = Piece(
 """,
     needs=("hex_value", "checksum"),
 )
+
+HEX_READ = """            if (end - at != PFX__DIGITS) {
+                return PFX_E_CHECKSUM;
+            }
+            for (k = at; k < end; k++) {
+                int v = pfx__hex_value(f[k]);
+                if (v < 0) {
+                    return PFX_E_CHECKSUM;
+                }
+                written = (written << 4) | (uint32_t)v;
+            }
+"""
+DECIMAL_READ = """            if (end - at < 1u || end - at > 3u) { /* 1 to 3 decimal digits */
+                return PFX_E_CHECKSUM;
+            }
+            for (k = at; k < end; k++) {
+                if (f[k] < 0x30u || f[k] > 0x39u) {
+                    return PFX_E_CHECKSUM;
+                }
+                written = written * 10u + (uint32_t)(f[k] - 0x30u);
+            }
+"""
+CHECKED_READ = Piece(_CHECKED_READ.text.replace("@DIGITS_READ@", HEX_READ), needs=("hex_value", "checksum"))
+DECIMAL_CHECKED_READ = Piece(_CHECKED_READ.text.replace("@DIGITS_READ@", DECIMAL_READ), needs=("checksum",))
 
 MIDDLE = Piece(
     r"""    *body = PFX__S;
@@ -736,9 +755,10 @@ static int pfx__trim(pfx__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[PFX__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked)
+static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated)
 {
     size_t k;
+    (void)separated;
 #if PFX__S
     o->b[0] = PFX__START;
 #endif
@@ -747,18 +767,39 @@ static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked)
     needs=("trim", "put", "frame"),
 )
 
-CHECKED_WRITE = Piece(
+_CHECKED_WRITE = Piece(
     r"""#if PFX__CHECKED
     if (!unchecked || PFX__REQUIRED) {
-        uint32_t sum = pfx__checksum(o->b + PFX__S, o->n - PFX__S);
+        uint32_t sum;
+        if (separated) { /* the separator before the marker, covered by the checksum */
+            pfx__put(o, PFX__SEPARATOR);
+        }
+        sum = pfx__checksum(o->b + PFX__S, o->n - PFX__S);
         pfx__put(o, PFX__MARKER);
-        for (k = PFX__DIGITS; k > 0u; k--) {
+@DIGITS_WRITE@    }
+#endif
+""",
+    needs=("checksum", "put"),
+)
+
+HEX_WRITE = """        for (k = PFX__DIGITS; k > 0u; k--) {
             uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
             pfx__put(o, (uint8_t)(nibble < 10u ? 0x30u + nibble : 0x37u + nibble));
         }
-    }
-#endif
-""",
+"""
+DECIMAL_WRITE = """        for (k = 0u; k == 0u || sum > 0u; k++) { /* decimal digits, backwards */
+            digits[k] = (uint8_t)(0x30u + sum % 10u);
+            sum /= 10u;
+        }
+        while (k > 0u) {
+            pfx__put(o, digits[--k]);
+        }
+"""
+CHECKED_WRITE = Piece(_CHECKED_WRITE.text.replace("@DIGITS_WRITE@", HEX_WRITE), needs=("checksum", "put"))
+DECIMAL_CHECKED_WRITE = Piece(
+    _CHECKED_WRITE.text.replace("@DIGITS_WRITE@", DECIMAL_WRITE).replace(
+        "        uint32_t sum;\n", "        uint32_t sum;\n        uint8_t digits[10];\n"
+    ),
     needs=("checksum", "put"),
 )
 

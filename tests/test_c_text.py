@@ -33,7 +33,8 @@ pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
 
 MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
 # frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), ended by CR LF; an
-# optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`)
+# optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`); a reply of
+# values alone, read as the reply awaited
 LINES = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_lines"}
 del LINES["framing"]["start"]
 LINES["framing"]["end"] = "\r\n"
@@ -44,6 +45,7 @@ LINES["framing"]["checksum"] = {
     "required": False,
     "separated": ["request"],
 }
+LINES["commands"]["dial"]["response"]["values_only"] = True  # ODrive's `r vbus_voltage` answered `24.1`
 CASES = {"c_text_matrix": MATRIX, "c_text_lines": LINES}
 SPECS = {
     "nmea0183": ROOT / "specs" / "nmea0183.yaml",
@@ -130,14 +132,38 @@ def c_may_refuse(b: Built, frame: bytes) -> bool:
     return digits > 18 or len(frame) > b.framing.max_length
 
 
-def check_decode(b: Built, frame: bytes, direction: str, run: Driver | None = None) -> None:
-    """The C decodes the frame as Python does (or both refuse), and encodes it again as Python does."""
+def kind_name(b: Built, sentence: TextSentence) -> str:
+    """The C kind name (p_kind_name) of a message."""
+    return f"{b.package.CODEC.classes[sentence.code, sentence.direction].COMMAND}_{sentence.direction}"
+
+
+def bare(b: Built) -> TextSentence | None:
+    """The case's reply of values alone (`values_only`), if it has one."""
+    return next((s for s in b.framing.sentences if s.bare), None)
+
+
+def check_decode(
+    b: Built, frame: bytes, direction: str, run: Driver | None = None, expect: TextSentence | None = None
+) -> None:
+    """The C decodes the frame as Python does (or both refuse), and encodes it again as Python does; with `expect`,
+    as that reply awaited (p_decode_expect: another kind refused; Python's decode given its code as `reply`)."""
     run = run or driver(b.name)
+    kind = "" if expect is None else f" {kind_name(b, expect)}"
     try:
-        sentence = b.framing.decode(frame, direction)
+        sentence = b.framing.decode(frame, direction, None if expect is None else expect.code)
     except DecodeError:
         sentence = None
-    (answer,) = run.ask(f"dec {direction} {frame.hex() or '-'}")
+    if (
+        expect is not None
+        and sentence is not None
+        and (sentence.code, sentence.direction)
+        != (
+            expect.code,
+            expect.direction,
+        )
+    ):
+        sentence = None  # another kind than the one awaited: the C's decode_expect refuses it
+    (answer,) = run.ask(f"dec {direction} {frame.hex() or '-'}{kind}")
     if sentence is None:
         assert answer.startswith("err "), f"C accepts {frame!r}, Python refuses it: {answer}"
         return
@@ -149,18 +175,19 @@ def check_decode(b: Built, frame: bytes, direction: str, run: Driver | None = No
         again: bytes | None = b.framing.encode_sentence(sentence)
     except EncodeError:
         again = None
-    (answer,) = run.ask(f"rt {direction} {frame.hex()}")
+    (answer,) = run.ask(f"rt {direction} {frame.hex()}{kind}")
     assert answer == (f"ok {again.hex()}" if again is not None else answer), (frame, answer, again)
     if again is None:
         assert answer.startswith("err "), (frame, answer)
 
 
 def python_stream(
-    b: Built, direction: str, data: bytes, gaps: tuple[int, ...] = ()
+    b: Built, direction: str, data: bytes, gaps: tuple[int, ...] = (), expect: TextSentence | None = None
 ) -> tuple[list[dict[str, Any]], tuple[int, ...]]:
     from serialspec.runtime.text import TextStreamParser
 
     parser = TextStreamParser(b.framing, direction)
+    parser.expect(None if expect is None else expect.code)
     found = []
     for at, byte in enumerate(data):
         for _ in range(gaps.count(at)):
@@ -172,15 +199,23 @@ def python_stream(
 
 
 def stream_agrees(
-    b: Built, direction: str, stream: bytes, sizes: str, run: Driver | None = None, gaps: tuple[int, ...] = ()
+    b: Built,
+    direction: str,
+    stream: bytes,
+    sizes: str,
+    run: Driver | None = None,
+    gaps: tuple[int, ...] = (),
+    expect: TextSentence | None = None,
 ) -> None:
-    """The C parser fed `stream` in pieces of `sizes`, told of a gap in the line before each offset of `gaps`, gives
-    the Python parser's sentences and counters; each one's raw frame (parser_frame) is the stream's next bytes."""
-    where = f" - {','.join(map(str, gaps))}" if gaps else ""
+    """The C parser fed `stream` in pieces of `sizes`, told of a gap in the line before each offset of `gaps` and
+    awaiting the reply `expect` (parser_expect), gives the Python parser's sentences and counters; each one's raw
+    frame (parser_frame) is the stream's next bytes."""
+    kind = "-" if expect is None else kind_name(b, expect)
+    where = f" {kind} {','.join(map(str, gaps))}" if gaps else f" {kind}" if expect is not None else ""
     answers = (run or driver(b.name)).ask(f"stream {direction} {sizes} {stream.hex() or '-'}{where}")
     messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
     counters = tuple(int(x) for x in answers[-1].split()[1:])
-    assert (messages, counters) == python_stream(b, direction, stream, gaps), stream
+    assert (messages, counters) == python_stream(b, direction, stream, gaps, expect), stream
     at = 0
     for frame in (bytes.fromhex(a[6:]) for a in answers if a.startswith("frame ")):
         found = stream.find(frame, at)
@@ -269,6 +304,9 @@ def test_random_messages_and_mutated_frames_decode_and_encode_as_python_does(nam
     def agree(case: tuple[str, bytes], data: st.DataObject) -> None:
         direction, frame = case
         check_decode(b, frame, direction)
+        awaited = bare(b)
+        if awaited is not None and direction == awaited.direction:  # read as the reply of values alone awaited
+            check_decode(b, frame, direction, expect=awaited)
         at = data.draw(st.integers(0, len(frame) - 1))
         flipped = (
             frame[:at] + bytes([data.draw(st.sampled_from(b"0123456789.-+,;*!#$ANSZaz\x00\x80"))]) + frame[at + 1 :]
@@ -307,8 +345,15 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
         stream_agrees(b, direction, stream, ",".join(map(str, sizes)))
         gaps = tuple(sorted(data.draw(st.lists(st.integers(0, len(stream)), max_size=4))))
         stream_agrees(b, direction, stream, ",".join(map(str, sizes)), gaps=gaps)  # the line idle at `gaps`
+        awaited = bare(b)
+        if awaited is not None and direction == awaited.direction:  # a reply of values alone awaited
+            stream_agrees(b, direction, stream, ",".join(map(str, sizes)), expect=awaited)
 
     agree()
+    reply = bare(b)
+    if reply is not None:  # answered once: the next line of values alone is no reply (none awaited any more)
+        line = b.framing.encode(reply.code, {"level": 7}, b.framing.talkers[0], direction=reply.direction)
+        stream_agrees(b, reply.direction, line + line, "1", expect=reply)
 
 
 @pytest.mark.parametrize("build", BUILDS[1:3])

@@ -23,6 +23,9 @@
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
 #define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
 #define NMEA0183__LIMIT 84u /* the parser drops a line longer than this without its line ending */
+#define NMEA0183__REPLY(p) NMEA0183_KIND_NONE
+#define NMEA0183__ANSWERED(p, out) ((void)0)
+#define NMEA0183__INIT_REPLY(p) ((void)0)
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_ENCODE || NMEA0183_ENABLE_PARSER
 static const uint8_t nmea0183__end[] = {0x0Du, 0x0Au, 0x00u}; /* '\r\n', the line ending */
 #endif
@@ -1128,7 +1131,10 @@ static nmea0183_kind_t nmea0183__lookup(const uint8_t *code, size_t n, nmea0183_
     return NMEA0183_KIND_NONE;
 }
 
-static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_msg_t *out)
+/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's first field is
+ * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
+                       nmea0183_msg_t *out)
 {
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
@@ -1156,20 +1162,21 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         }
     }
     talker = address < 2u ? address : 2u;
-    for (i = 0u; i < talker; i++) {{
+    for (i = 0u; i < talker; i++) {
         out->talker[i] = (char)frame[body + i];
-    }}
+    }
     out->talker[talker] = '\0';
     kind = nmea0183__lookup(frame + body + talker, address - talker, dir);
-    if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
-        return NMEA0183_E_UNKNOWN;
-    }
     out->sent = (int32_t)seps;
-    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+    (void)reply;
+    if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
+        return NMEA0183_E_UNKNOWN;
+    }
+    out->unchecked = unchecked != 0;
     switch (kind) {
     case NMEA0183_GGA_RESPONSE:
         memset(&out->u.gga_response, 0, sizeof(out->u.gga_response));
@@ -1204,12 +1211,12 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
 
 int nmea0183_decode_expect(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_msg_t *out)
 {
-    return nmea0183__decode(frame, len, dir, expect, out);
+    return nmea0183__decode(frame, len, dir, expect, NMEA0183_KIND_NONE, out);
 }
 
 int nmea0183_decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_msg_t *out)
 {
-    return nmea0183__decode(frame, len, dir, NMEA0183_KIND_NONE, out);
+    return nmea0183__decode(frame, len, dir, NMEA0183_KIND_NONE, NMEA0183_KIND_NONE, out);
 }
 #endif
 
@@ -1830,9 +1837,9 @@ static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183
 static int nmea0183__body(const nmea0183_msg_t *msg, nmea0183__out_t *o, int check)
 {
     size_t i;
-    for (i = 0u; i < 2u && msg->talker[i] != '\0'; i++) {{
+    for (i = 0u; i < 2u && msg->talker[i] != '\0'; i++) {
         nmea0183__put(o, (uint8_t)msg->talker[i]);
-    }}
+    }
     switch (msg->kind) {
     case NMEA0183_GGA_RESPONSE:
         if (check && !NMEA0183_ENCODES_RESPONSES) {
@@ -1952,9 +1959,10 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
             return 0;
         }
         {
-            int r = nmea0183__decode(p->buf, end + k, p->dir, NMEA0183_KIND_NONE, out);
+            int r = nmea0183__decode(p->buf, end + k, p->dir, NMEA0183_KIND_NONE, NMEA0183__REPLY(p), out);
             nmea0183__drop(p, end + k);
             if (r == NMEA0183_OK) {
+                NMEA0183__ANSWERED(p, out);
                 p->frames++;
                 p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
                 p->frame_len = end + k;
@@ -1986,6 +1994,7 @@ void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
 #if !NMEA0183__S
     parser->overlong = 0u;
 #endif
+    NMEA0183__INIT_REPLY(parser);
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;
@@ -2078,6 +2087,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
             return r;
         }
     }
+
     return nmea0183__frame(&o, len, msg->unchecked, 0);
 }
 #endif

@@ -71,6 +71,7 @@ class TextC:
         self.protocol, self.text = protocol, text
         self.p, self.P = protocol.name, protocol.name.upper()
         self.limit = text.max_length + len(text.end)
+        self.bare_macros = ""  # replies of values alone: the macros that tell their kinds (bare_decode)
         self.calls: set[str] = set()  # the runtime's helpers the code written calls (text_runtime.used)
 
     def call(self, helper: str) -> str:
@@ -147,6 +148,11 @@ class TextC:
             if t.start
             else "    uint8_t overlong; /* frames without a start: the line being read was dropped as too long */\n"
         )
+        if any(m.values_only for m in t.messages):  # replies of values alone: read as the reply awaited
+            overlong += (
+                f"    {p}_kind_t awaited; /* the reply awaited ({p}_parser_expect), until a response of it */\n"
+                f"    {p}_kind_t asked;   /* the reply of values alone of the request just read */\n"
+            )
         return f"""{banner(self.protocol)}
 #ifndef {P}_H
 #define {P}_H
@@ -455,8 +461,96 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
     return {P}_OK;
 }}"""
 
+    def bare_decode(self, bare: list[TextMessage]) -> tuple[str, str, str, str]:
+        """Replies of values alone (`values_only`: ODrive's `r vbus_voltage` answered `24.1`), read as the reply
+        awaited where a frame's first field is no code of its direction (runtime/text.py TextFraming.decode's
+        `reply`): the helpers before the decoder, the decoder's reading of one, encode's dropping of the separator
+        before its first value, and decode_expect's reply awaited."""
+        p, P, t = self.p, self.P, self.text
+        if not bare:
+            return "", "    (void)reply;\n", "", f"{P}_KIND_NONE"
+        cases = []
+        for m in bare:
+            same = [o for o in t.messages if o.code == m.code]
+            labels = "".join(f"    case {P}_{mid(o).upper()}:\n" for o in same)
+            cases.append(f"{labels}        return {P}_{mid(m).upper()};")
+        coded = [m for m in t.messages if not m.values_only]
+        requests = [m for m in t.messages if m.direction.value == "request"]
+        responses = [m for m in t.messages if m.direction.value == "response"]
+
+        def kinds(found: list[TextMessage]) -> str:
+            return " || ".join(f"(kind) == {P}_{mid(m).upper()}" for m in found) or "0"
+
+        coded_cases = [f"    case {P}_{mid(m).upper()}:\n        return dir == {P}_{m.direction.name};" for m in coded]
+        self.bare_macros = f"""/* Replies of values alone (`values_only`): no code, so read as the reply awaited. */
+#define {P}__BARE(kind) ({kinds(bare)})
+#define {P}__IS_REQUEST(kind) ({kinds(requests)})
+#define {P}__IS_RESPONSE(kind) ({kinds(responses)})
+"""
+        helpers = f"""/* The reply of values alone that answers `kind`'s code (its request's, or its own), or none. */
+static {p}_kind_t {p}__bare_reply({p}_kind_t kind)
+{{
+    switch (kind) {{
+{chr(10).join(cases)}
+    default:
+        return {P}_KIND_NONE;
+    }}
+}}
+
+/* 1 when `kind` (what a frame's code names) is a message sent with its code, in `dir`. */
+static int {p}__coded({p}_kind_t kind, {p}_direction_t dir)
+{{
+    switch (kind) {{
+{chr(10).join(coded_cases)}
+    default:
+        return 0;
+    }}
+}}
+
+#if {P}_ENABLE_PARSER
+/* After a message the parser gives (runtime/text.py TextStreamParser._decoded): the reply awaited answered; a
+ * request read, whose reply of values alone is read next. */
+static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
+{{
+    if (out->kind == p->awaited && {P}__IS_RESPONSE(out->kind)) {{
+        p->awaited = {P}_KIND_NONE;
+    }}
+    p->asked = {P}__IS_REQUEST(out->kind) ? {p}__bare_reply(out->kind) : {P}_KIND_NONE;
+}}
+#endif
+
+"""
+        read = f"""    if (reply != {P}_KIND_NONE && dir != {P}_REQUEST && !{p}__coded(kind, dir)) {{
+        /* the reply of values alone awaited: its values from the first field on, no talker */
+        kind = reply;
+        out->talker[0] = '\\0';
+        out->sent = (int32_t)(seps + 1u);
+        c.more = 1;
+        c.pos = 0u;
+    }}
+"""
+        write = f"""    if ({P}__BARE(msg->kind) && !o.full && o.n > {P}__S && o.b[{P}__S] == {P}__SEPARATOR) {{
+        for (i = {P}__S; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
+            o.b[i] = o.b[i + 1u];
+        }}
+        o.n--;
+    }}
+"""
+        return helpers, read, write, f"{p}__bare_reply(expect)"
+
+    def bare_expect(self) -> str:
+        """p_parser_expect where replies of values alone are read as the reply awaited (TextStreamParser.expect)."""
+        p = self.p
+        return f"""
+void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
+{{
+    parser->awaited = reply;
+}}
+"""
+
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
+        bare = [m for m in t.messages if m.values_only]  # replies of values alone (`values_only`)
         end = ", ".join(_byte(c) for c in t.end)
         special_characters = sorted({t.start, t.separator, t.marker, *t.end} - {""})
         checked = t.checksum is not None
@@ -511,17 +605,17 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             f"    case {P}_{mid(m).upper()}:\n"
             f"        if (check && !{P}_ENCODES_{m.direction.name}S) {{\n"
             f"            return {P}_E_ARG; /* left out */\n        }}\n"
-            f"        {self.call('put_text')}(o, {c_text(m.code)}, {len(m.code)}u);\n"
-            f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
+            + ("" if m.values_only else f"        {self.call('put_text')}(o, {c_text(m.code)}, {len(m.code)}u);\n")
+            + f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
             for m in t.messages
         )
         talkers = " && ".join(f'!{p}__is((const uint8_t *)msg->talker, {t.talker}u, "{x}")' for x in t.talkers)
         talker_read = "    talker = 0u;\n    out->talker[0] = '\\0';"
         if t.talker:
             talker_read = f"""    talker = address < {t.talker}u ? address : {t.talker}u;
-    for (i = 0u; i < talker; i++) {{{{
+    for (i = 0u; i < talker; i++) {{
         out->talker[i] = (char)frame[body + i];
-    }}}}
+    }}
     out->talker[talker] = '\\0';"""
         talker_check = f"""    for (i = 0u; i < {t.talker}u; i++) {{
         if (msg->talker[i] == '\\0') {{
@@ -538,9 +632,9 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             ""
             if not t.talker
             else f"""    size_t i;
-    for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{{{
+    for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{
         {self.call("put")}(o, (uint8_t)msg->talker[i]);
-    }}}}"""
+    }}"""
         )
         special = Piece(
             f"""/* The framing's own characters: no field may hold one. */
@@ -571,7 +665,7 @@ static int {p}__special(uint8_t c)
             + "}\n"
             + parser_api.push_function(p, P, None)
             + parser_api.frame_function(p)
-            + parser_api.expect_function(p, P, True)
+            + (parser_api.expect_function(p, P, True) if not bare else self.bare_expect())
             + "#endif\n"
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
@@ -580,6 +674,20 @@ static int {p}__special(uint8_t c)
         separated_dirs = " || ".join(f"(dir) == {P}_{d.upper()}" for d in t.checksum_separated)
         separated_dirs = f"({separated_dirs})" if separated_dirs else "0"
         separated_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in separated) or "0"
+        bare_helpers, bare_read, bare_write, expect_reply = self.bare_decode(bare)
+        talker_write_bare = talker_write
+        if bare and talker_write:  # a reply of values alone: no talker written
+            talker_write_bare = f"    if (!{P}__BARE(msg->kind)) {{\n{talker_write}\n    }}"
+        reply_macros = (
+            f"/* the reply of values alone the parser reads next (the reply awaited's, or the last request's) */\n"
+            f"#define {P}__REPLY(p) ((p)->awaited != {P}_KIND_NONE ? {p}__bare_reply((p)->awaited) : (p)->asked)\n"
+            f"#define {P}__ANSWERED(p, out) {p}__answered((p), (out))\n"
+            f"#define {P}__INIT_REPLY(p) ((p)->awaited = {P}_KIND_NONE, (p)->asked = {P}_KIND_NONE)\n"
+            + self.bare_macros
+            if bare
+            else f"#define {P}__REPLY(p) {P}_KIND_NONE\n#define {P}__ANSWERED(p, out) ((void)0)\n"
+            f"#define {P}__INIT_REPLY(p) ((void)0)\n"
+        )
         start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
         room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
@@ -602,7 +710,7 @@ static int {p}__special(uint8_t c)
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
 #define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
 #define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
-#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
+{reply_macros}#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
 static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
 #endif
 
@@ -646,7 +754,10 @@ static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir
     return {P}_KIND_NONE;
 }}
 
-static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
+{bare_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's first field is
+ * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
+                       {p}_msg_t *out)
 {{
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
@@ -675,15 +786,15 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     }}
 {talker_read}
     kind = {p}__lookup(frame + body + talker, address - talker, dir);
-    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
-        return {P}_E_UNKNOWN;
-    }}
     out->sent = (int32_t)seps;
-    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+        return {P}_E_UNKNOWN;
+    }}
+    out->unchecked = unchecked != 0;
     switch (kind) {{
 {dec_cases}
     case {P}_KIND_NONE:
@@ -699,12 +810,12 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
 
 int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
 {{
-    return {p}__decode(frame, len, dir, expect, out);
+    return {p}__decode(frame, len, dir, expect, {expect_reply}, out);
 }}
 
 int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out)
 {{
-    return {p}__decode(frame, len, dir, {P}_KIND_NONE, out);
+    return {p}__decode(frame, len, dir, {P}_KIND_NONE, {P}_KIND_NONE, out);
 }}
 #endif
 
@@ -713,7 +824,7 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 /* Talker, code and fields (range-checked when `check`), from o's position on. */
 static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
 {{
-{talker_write}
+{talker_write_bare}
     switch (msg->kind) {{
 {enc_cases}
     case {P}_KIND_NONE:
@@ -767,6 +878,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
             return r;
         }}
     }}
+{bare_write}
     return {p}__frame(&o, len, msg->unchecked, {separated_kinds});
 }}
 #endif

@@ -883,9 +883,10 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
             return 0;
         }
         {
-            int r = pfx__decode(p->buf, end + k, p->dir, PFX_KIND_NONE, out);
+            int r = pfx__decode(p->buf, end + k, p->dir, PFX_KIND_NONE, PFX__REPLY(p), out);
             pfx__drop(p, end + k);
             if (r == PFX_OK) {
+                PFX__ANSWERED(p, out);
                 p->frames++;
                 p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
                 p->frame_len = end + k;
@@ -957,11 +958,12 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
     while (p->buf[from] == 0x0Du || p->buf[from] == 0x0Au) {
         from++;
     }
-    r = pfx__decode(p->buf + from, p->n - from, p->dir, PFX_KIND_NONE, out);
+    r = pfx__decode(p->buf + from, p->n - from, p->dir, PFX_KIND_NONE, PFX__REPLY(p), out);
     p->frame = p->buf + from; /* it ends with the byte just pushed: nothing held after it */
     p->frame_len = p->n - from;
     p->n = 0u;
     if (r == PFX_OK) {
+        PFX__ANSWERED(p, out);
         p->frames++;
         return 1;
     }
@@ -999,6 +1001,7 @@ PARSER = Piece(
 #if !PFX__S
     parser->overlong = 0u;
 #endif
+    PFX__INIT_REPLY(parser);
     parser->frames = 0u;
     parser->garbage = 0u;
     parser->errors = 0u;

@@ -351,7 +351,7 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
 
     agree()
     reply = bare(b)
-    if reply is not None:  # answered once: the next line of values alone is no reply (none awaited any more)
+    if reply is not None and name == "c_text_lines":  # answered once: the next line of values is no reply any more
         line = b.framing.encode(reply.code, {"level": 7}, b.framing.talkers[0], direction=reply.direction)
         stream_agrees(b, reply.direction, line + line, "1", expect=reply)
 

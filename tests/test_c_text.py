@@ -32,6 +32,7 @@ from test_text_frames import sentence_values
 pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
 
 MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
+MATRIX["framing"]["end"] = "\xff\xff\xff"  # a line ending of bytes above 0x7F (Nextion's FF FF FF)
 # frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), ended by CR LF; an
 # optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`); a reply of
 # values alone, read as the reply awaited
@@ -285,7 +286,7 @@ def test_every_example_decodes_to_the_spec_texts_and_encodes_back(name: str) -> 
     assert text.examples or name == "c_text_matrix"
     for example in text.examples:
         frame = example.printed.encode("ascii")
-        frame += b"" if frame.endswith(b.framing.end.encode()) else b.framing.end.encode()
+        frame += b"" if frame.endswith(b.framing.end.encode("latin-1")) else b.framing.end.encode("latin-1")
         direction = example.direction.value
         (answer,) = driver(name).ask(f"dec {direction} {frame.hex()}")
         assert answer.startswith("ok "), (example.name, answer)
@@ -320,7 +321,7 @@ def test_random_messages_and_mutated_frames_decode_and_encode_as_python_does(nam
 @pytest.mark.parametrize("name", DIFFERENTIAL)
 def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(name: str) -> None:
     b = built(name)
-    start, end = b.framing.start.encode(), b.framing.end.encode()
+    start, end = b.framing.start.encode(), b.framing.end.encode("latin-1")
 
     @settings(max_examples=examples(25), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(directions(b)), st.data())

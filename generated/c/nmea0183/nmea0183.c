@@ -481,13 +481,13 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t 
     size_t i, end = len, stop;
     *unchecked = 0;
     (void)dir;
-    for (i = 0u; i < len; i++) {
+    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
+        end = len - (sizeof(nmea0183__end) - 1u);
+    }
+    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
         }
-    }
-    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
-        end = len - (sizeof(nmea0183__end) - 1u);
     }
 #if NMEA0183__S
     if (end < 1u || f[0] != NMEA0183__START) {

@@ -648,13 +648,13 @@ static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_
     size_t i, end = len, stop;
     *unchecked = 0;
     (void)dir;
-    for (i = 0u; i < len; i++) {
+    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
+        end = len - (sizeof(pfx__end) - 1u);
+    }
+    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
         }
-    }
-    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
-        end = len - (sizeof(pfx__end) - 1u);
     }
 #if PFX__S
     if (end < 1u || f[0] != PFX__START) {

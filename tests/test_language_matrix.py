@@ -1190,14 +1190,18 @@ CASES[MIXED] = Case(
 )
 
 # Layouts chosen by command with frame values of their own (RPLIDAR: the response descriptor's size and mode beside
-# headerless measurements that carry none): each message carries its own layout's values
+# headerless measurements that carry none; HCI's ACL handle and flags beside commands and events that carry none):
+# each message carries its own layout's values (the C: its own layout's, in its struct and the engine's values[])
 OWN_VALUES = "frame: layouts chosen by command, a frame value one layout has and another has not"
 CASES[OWN_VALUES] = copy.deepcopy(CASES[MIXED])
 _data = CASES[OWN_VALUES].framing["layouts"]["data"]["elements"]
 _data["seq"] = {"role": "value", "type": "u8", "range": [0, 99]}
 _data["content"] = _data.pop("content")
 _data["sum"] = _data.pop("sum")
-C_REFUSES[OWN_VALUES] = "layouts chosen by command with different frame values"
+_config = CASES[OWN_VALUES].framing["layouts"]["config"]["elements"]
+_config["handle"] = {"role": "value", "type": "u16", "bits": {"link": {"bits": [11, 0]}, "kind": {"bits": [15, 12]}}}
+_config["content"] = _config.pop("content")
+_config["code"] = _config.pop("code")
 
 # A length counting the whole frame, from the header before it (Benewake TFmini Plus: 5A, the frame's length, ...)
 CASES["frame: a length counting from the header before it"] = Case(
@@ -1920,9 +1924,10 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
 
 
 def test_a_reply_of_values_alone_through_every_output() -> None:
-    """`values_only` on a text response (the dial's): the C target and the dissector, which read each line alone,
-    refuse it in one line; the reference shows the reply without its code; the package reads it with its request,
-    the simulator answers with it, and a stream of both directions takes it after its request."""
+    """`values_only` on a text response (the dial's): the dissector, which reads each line alone, refuses it in one
+    line (the C reads it as the reply awaited: tests/test_c_text.py holds it to Python, in the case without a
+    start); the reference shows the reply without its code; the package reads it with its request, the simulator
+    answers with it, and a stream of both directions takes it after its request."""
     from serialspec.backends import Unsupported
 
     case = copy.deepcopy(TEXT_CASE)
@@ -1930,14 +1935,14 @@ def test_a_reply_of_values_alone_through_every_output() -> None:
     protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name in ("c", "wireshark"):
+        if emitter.name == "wireshark":
             with pytest.raises(Unsupported, match="a reply of values alone"):
                 emitter.files(protocol)
             continue
         emitted = emitter.files(protocol)
         assert emitter.verify is None or emitter.verify(protocol, emitted) == []
         files.update(emitted)
-    assert "its values alone: no code" in files["docs/matrix_text.md"]
+    assert "its values alone: no code" in files["docs/matrix_text.md"] and "matrix_text/matrix_text.c" in files
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         device = importlib.import_module("matrix_text.simulator").SIMULATOR()
@@ -2052,14 +2057,16 @@ def streams_back(package: ModuleType, classes: tuple[Any, ...], direction: str |
     assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
 
 
-def python_and_markdown(case: dict[str, Any], refused: str) -> dict[str, str]:
-    """A text case's files from every output but C and Wireshark (each verified), which refuse it in one line."""
+def python_and_markdown(
+    case: dict[str, Any], refused: str, refusing: tuple[str, ...] = ("c", "wireshark")
+) -> dict[str, str]:
+    """A text case's files from every output but those `refusing` it in one line (each verified)."""
     from serialspec.backends import Unsupported
 
     protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name in ("c", "wireshark"):
+        if emitter.name in refusing:
             with pytest.raises(Unsupported, match=refused):
                 emitter.files(protocol)
             continue
@@ -2070,14 +2077,16 @@ def python_and_markdown(case: dict[str, Any], refused: str) -> dict[str, str]:
 
 
 def test_a_decimal_text_checksum_through_every_output() -> None:
-    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): the C target and the dissector refuse it in one line;
+    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): the dissector refuses it in one line (the C takes it:
+    tests/test_c_text.py holds its C to Python, in the case without a start);
     the reference says how it is written; the package writes the checksum in decimal (no leading zeros), reads it
     back, refuses a wrong one and random messages round trip, byte by byte through the stream parser too."""
     from serialspec.runtime.errors import ChecksumError
 
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"] = {"algorithm": "xor", "format": "decimal", "marker": "!"}
-    files = python_and_markdown(case, r"^a text checksum written in decimal \(`format: decimal`\)$")
+    files = python_and_markdown(case, r"^a text checksum written in decimal \(`format: decimal`\)$", ("wireshark",))
+    assert "matrix_text/matrix_text.c" in files  # (the C target, beside the package: matrix_text/*.py)
     assert "`!` + its value in decimal digits (0 to 255)" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2179,12 +2188,16 @@ def test_a_text_checksum_in_one_direction_through_every_output() -> None:
 
 
 def test_an_optional_text_checksum_after_a_separator_through_every_output() -> None:
-    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): C and Wireshark refuse
-    it in one line; requests write the separator before the marker, covered by the checksum, responses do not; a
-    frame sent without the checksum decodes and encodes again without it; random messages round trip."""
+    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): Wireshark refuses it in
+    one line (the C takes it: tests/test_c_text.py holds its C to Python, in the case without a start); requests
+    write the separator before the marker, covered by the checksum, responses do not; a frame sent without the
+    checksum decodes and encodes again without it; random messages round trip."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"].update({"required": False, "separated": ["request"]})
-    files = python_and_markdown(case, r"^a separator before the text checksum \(`checksum.separated`\)$")
+    files = python_and_markdown(
+        case, r"^a separator before the text checksum \(`checksum.separated`\)$", ("wireshark",)
+    )
+    assert "matrix_text/matrix_text.c" in files  # (the C target, beside the package: matrix_text/*.py)
     assert "requests write `;` before the marker, covered by it" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

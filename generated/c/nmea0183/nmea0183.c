@@ -14,13 +14,18 @@
 #define NMEA0183__DECODES(dir) ((dir) == NMEA0183_REQUEST ? NMEA0183_DECODES_REQUESTS : (dir) == NMEA0183_RESPONSE && NMEA0183_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says (`$`, the talker id and the sentence id (GPGGA), each field after a comma, then `*` and the XOR of every character between `$` and `*` as two upper-case hex digits, then CR LF; at most 82 characters (gpsd: "NMEA Revealed"). NMEA 0183 makes the checksum optional for some sentences, so a sentence without one is accepted unchecked.) ---- */
-#define NMEA0183__START 0x24u            /* '$' */
+#define NMEA0183__S 1u /* the start character's bytes: 1, or 0 where every line is a frame */
+#define NMEA0183__START 0x24u /* '$' */
 #define NMEA0183__SEPARATOR 0x2Cu    /* ',' */
 #define NMEA0183__MARKER 0x2Au          /* '*': the checksum follows */
 #define NMEA0183__CHECKED 1            /* a checksum is written */
 #define NMEA0183__REQUIRED 0        /* a frame without one is refused */
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
+#define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
 #define NMEA0183__LIMIT 84u /* the parser drops a line longer than this without its line ending */
+#define NMEA0183__REPLY(p) NMEA0183_KIND_NONE
+#define NMEA0183__ANSWERED(p, out) ((void)0)
+#define NMEA0183__INIT_REPLY(p) ((void)0)
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_ENCODE || NMEA0183_ENABLE_PARSER
 static const uint8_t nmea0183__end[] = {0x0Du, 0x0Au, 0x00u}; /* '\r\n', the line ending */
 #endif
@@ -469,31 +474,35 @@ static int nmea0183__hex_value(uint8_t c)
 }
 
 /* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; NMEA0183_E_FRAME,
- * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
-static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
+ * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
+ * separator before the marker, it is no part of the fields. */
+static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
     *unchecked = 0;
-    for (i = 0u; i < len; i++) {
+    (void)dir;
+    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
+        end = len - (sizeof(nmea0183__end) - 1u);
+    }
+    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
         }
     }
-    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
-        end = len - (sizeof(nmea0183__end) - 1u);
-    }
+#if NMEA0183__S
     if (end < 1u || f[0] != NMEA0183__START) {
         return NMEA0183_E_FRAME;
     }
+#endif
     stop = end;
 #if NMEA0183__CHECKED
     {
         size_t at = end, k;
         uint32_t written = 0u;
-        while (at > 1u && f[at - 1u] != NMEA0183__MARKER) {
+        while (at > NMEA0183__S && f[at - 1u] != NMEA0183__MARKER) {
             at--;
         }
-        if (at > 1u) {
+        if (at > NMEA0183__S) {
             if (end - at != NMEA0183__DIGITS) {
                 return NMEA0183_E_CHECKSUM;
             }
@@ -505,8 +514,11 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
                 written = (written << 4) | (uint32_t)v;
             }
             stop = at - 1u;
-            if (written != nmea0183__checksum(f + 1u, stop - 1u)) {
+            if (written != nmea0183__checksum(f + NMEA0183__S, stop - NMEA0183__S)) {
                 return NMEA0183_E_CHECKSUM;
+            }
+            if (NMEA0183__SEPARATED(dir) && stop > NMEA0183__S && f[stop - 1u] == NMEA0183__SEPARATOR) {
+                stop--; /* the separator before the marker, covered by the checksum */
             }
         } else if (NMEA0183__REQUIRED) {
             return NMEA0183_E_CHECKSUM;
@@ -515,19 +527,19 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, size_t *body, size_t 
         }
     }
 #endif
-    *body = 1u;
-    *n = stop - 1u;
+    *body = NMEA0183__S;
+    *n = stop - NMEA0183__S;
     return NMEA0183_OK;
 }
 #endif
 
 #if NMEA0183_ENABLE_ENCODE
-/* Exactly `sent` fields after the address (o->b[1..n): the address, then each field after a separator): the fields
+/* Exactly `sent` fields after the address (o->b[NMEA0183__S..n): the address, then each field after a separator): the fields
  * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. */
 static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 {
     size_t i, k, fields = 0u;
-    for (i = 1u; i < o->n; i++) {
+    for (i = NMEA0183__S; i < o->n; i++) {
         if (o->b[i] == NMEA0183__SEPARATOR && ++fields > sent) {
             break;
         }
@@ -547,16 +559,23 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
     return NMEA0183_OK;
 }
 
-/* The frame around fields already written from buf[1]: the start before them, checksum (unless `unchecked`: a
+/* The frame around fields already written from buf[NMEA0183__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked)
+static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated)
 {
     size_t k;
+    (void)separated;
+#if NMEA0183__S
     o->b[0] = NMEA0183__START;
+#endif
     (void)unchecked;
 #if NMEA0183__CHECKED
     if (!unchecked || NMEA0183__REQUIRED) {
-        uint32_t sum = nmea0183__checksum(o->b + 1u, o->n - 1u);
+        uint32_t sum;
+        if (separated) { /* the separator before the marker, covered by the checksum */
+            nmea0183__put(o, NMEA0183__SEPARATOR);
+        }
+        sum = nmea0183__checksum(o->b + NMEA0183__S, o->n - NMEA0183__S);
         nmea0183__put(o, NMEA0183__MARKER);
         for (k = NMEA0183__DIGITS; k > 0u; k--) {
             uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
@@ -1112,7 +1131,10 @@ static nmea0183_kind_t nmea0183__lookup(const uint8_t *code, size_t n, nmea0183_
     return NMEA0183_KIND_NONE;
 }
 
-static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_msg_t *out)
+/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's first field is
+ * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
+                       nmea0183_msg_t *out)
 {
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
@@ -1128,7 +1150,7 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
-    r = nmea0183__unframe(frame, len, &body, &n, &unchecked);
+    r = nmea0183__unframe(frame, len, dir, &body, &n, &unchecked);
     if (r != NMEA0183_OK) {
         return r;
     }
@@ -1140,20 +1162,21 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         }
     }
     talker = address < 2u ? address : 2u;
-    for (i = 0u; i < talker; i++) {{
+    for (i = 0u; i < talker; i++) {
         out->talker[i] = (char)frame[body + i];
-    }}
+    }
     out->talker[talker] = '\0';
     kind = nmea0183__lookup(frame + body + talker, address - talker, dir);
-    if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
-        return NMEA0183_E_UNKNOWN;
-    }
     out->sent = (int32_t)seps;
-    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+    (void)reply;
+    if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
+        return NMEA0183_E_UNKNOWN;
+    }
+    out->unchecked = unchecked != 0;
     switch (kind) {
     case NMEA0183_GGA_RESPONSE:
         memset(&out->u.gga_response, 0, sizeof(out->u.gga_response));
@@ -1188,12 +1211,12 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
 
 int nmea0183_decode_expect(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_msg_t *out)
 {
-    return nmea0183__decode(frame, len, dir, expect, out);
+    return nmea0183__decode(frame, len, dir, expect, NMEA0183_KIND_NONE, out);
 }
 
 int nmea0183_decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_msg_t *out)
 {
-    return nmea0183__decode(frame, len, dir, NMEA0183_KIND_NONE, out);
+    return nmea0183__decode(frame, len, dir, NMEA0183_KIND_NONE, NMEA0183_KIND_NONE, out);
 }
 #endif
 
@@ -1814,9 +1837,9 @@ static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183
 static int nmea0183__body(const nmea0183_msg_t *msg, nmea0183__out_t *o, int check)
 {
     size_t i;
-    for (i = 0u; i < 2u && msg->talker[i] != '\0'; i++) {{
+    for (i = 0u; i < 2u && msg->talker[i] != '\0'; i++) {
         nmea0183__put(o, (uint8_t)msg->talker[i]);
-    }}
+    }
     switch (msg->kind) {
     case NMEA0183_GGA_RESPONSE:
         if (check && !NMEA0183_ENCODES_RESPONSES) {
@@ -1936,9 +1959,10 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
             return 0;
         }
         {
-            int r = nmea0183__decode(p->buf, end + k, p->dir, NMEA0183_KIND_NONE, out);
+            int r = nmea0183__decode(p->buf, end + k, p->dir, NMEA0183_KIND_NONE, NMEA0183__REPLY(p), out);
             nmea0183__drop(p, end + k);
             if (r == NMEA0183_OK) {
+                NMEA0183__ANSWERED(p, out);
                 p->frames++;
                 p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
                 p->frame_len = end + k;
@@ -1955,24 +1979,28 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
     }
 }
 
-void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
-{
-    parser->dir = dir;
-    parser->n = 0u;
-    parser->frames = 0u;
-    parser->garbage = 0u;
-    parser->errors = 0u;
-    parser->unknown = 0u;
-    parser->frame = NULL;
-    parser->frame_len = 0u;
-}
-
 void nmea0183_parser_gap(nmea0183_parser_t *parser)
 {
     if (parser->n > 0u) { /* it begins with the start character */
         parser->errors++;
     }
     parser->n = 0u;
+}
+
+void nmea0183_parser_init(nmea0183_parser_t *parser, nmea0183_direction_t dir)
+{
+    parser->dir = dir;
+    parser->n = 0u;
+#if !NMEA0183__S
+    parser->overlong = 0u;
+#endif
+    NMEA0183__INIT_REPLY(parser);
+    parser->frames = 0u;
+    parser->garbage = 0u;
+    parser->errors = 0u;
+    parser->unknown = 0u;
+    parser->frame = NULL;
+    parser->frame_len = 0u;
 }
 
 size_t nmea0183_parser_feed(nmea0183_parser_t *parser, const uint8_t *data, size_t len, nmea0183_msg_t *out, bool *got)
@@ -2047,7 +2075,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
     }
     o.b = buf;
     o.cap = cap;
-    o.n = 1u;
+    o.n = NMEA0183__S;
     o.full = 0;
     r = nmea0183__body(msg, &o, 1);
     if (r != NMEA0183_OK) {
@@ -2059,7 +2087,8 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
             return r;
         }
     }
-    return nmea0183__frame(&o, len, msg->unchecked);
+
+    return nmea0183__frame(&o, len, msg->unchecked, 0);
 }
 #endif
 

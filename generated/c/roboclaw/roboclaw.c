@@ -2431,7 +2431,7 @@ int roboclaw_decode_expect(const uint8_t *frame, size_t len, roboclaw_direction_
 
 int roboclaw_decode_reply(const uint8_t *frame, size_t len, const roboclaw_msg_t *request, roboclaw_msg_t *out)
 {
-    uint8_t pre[ROBOCLAW_REQUEST_BYTES];
+    uint8_t pre[ROBOCLAW_REQUEST_BYTES] = {0u}; /* zeroed: only n bytes are read, which gcc cannot tell */
     size_t n;
     roboclaw_kind_t reply;
     if (frame == NULL || out == NULL) {
@@ -4099,7 +4099,7 @@ int roboclaw_encode(const roboclaw_msg_t *msg, uint8_t *buf, size_t cap, size_t 
 
 int roboclaw_encode_reply(const roboclaw_msg_t *msg, const roboclaw_msg_t *request, uint8_t *buf, size_t cap, size_t *len)
 {
-    uint8_t pre[ROBOCLAW_REQUEST_BYTES];
+    uint8_t pre[ROBOCLAW_REQUEST_BYTES] = {0u}; /* zeroed: only n bytes are read, which gcc cannot tell */
     size_t n;
     roboclaw_kind_t reply;
     if (msg == NULL || buf == NULL || len == NULL) {

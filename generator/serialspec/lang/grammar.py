@@ -817,8 +817,8 @@ COMMAND = Obj(
             "`set_mode: {code: 0x11, layout: config}`); a command element after a content of one size per code, "
             "with no length, is found by trying each code's size. They may also carry different frame values (an "
             "`address`, `status` or `value` one layout has and another has not: RPLIDAR's response descriptor beside "
-            "its headerless measurements): each message carries its own layout's (the C target refuses such a "
-            "spec, saying so). The C decoder takes such a spec where each frame "
+            "its headerless measurements): each message carries its own layout's (in the C, its struct holds its own "
+            "layout's values). The C decoder takes such a spec where each frame "
             "says how to read it (replies through `p_decode_reply` with their request); the Wireshark dissector "
             "reads a reply with the last request before it in the capture, and marks one whose request is not in "
             "the capture (expert note `Request not in capture`).",

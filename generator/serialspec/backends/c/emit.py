@@ -260,9 +260,6 @@ def refuse_by_request(protocol: Protocol) -> None:
     if not framing.by_command:
         return
     for direction, layouts in framing.alternatives.items():
-        values = {tuple((e.name, e.type) for e in layout.value_elements) for layout in layouts}
-        if len(values) > 1:
-            raise Unsupported(f"layouts chosen by command with different frame values ({direction.value} frames)")
         if any(layout.transparency is not None or layout.optional for layout in layouts):
             raise Unsupported(
                 f"layouts chosen by command with a frame transform or optional elements ({direction.value} frames)"
@@ -360,8 +357,10 @@ def messages(protocol: Protocol) -> list[Message]:
     return list(protocol.messages())
 
 
-def value_elements(protocol: Protocol, direction: Direction) -> tuple[tuple[str, ScalarType], ...]:
-    layout = protocol.framing.layouts[direction]
+def value_elements(protocol: Protocol, message: Message) -> tuple[tuple[str, ScalarType], ...]:
+    """The frame values a message's struct holds: its own layout's (layouts chosen by command may each have others),
+    in the order the frame engine reads them into `values[]`."""
+    layout = protocol.layout(message)
     return tuple((e.name, e.type) for e in layout.value_elements if e.type is not None)
 
 

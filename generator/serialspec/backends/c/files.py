@@ -136,7 +136,7 @@ def header(ctx: Ctx) -> str:
             room = min(room, m.max_size)
         found = [
             Member(ident(name), f"{_ctype_of(t)} {ident(name)};", f"frame {name}", _ctype_of(t))
-            for name, t in value_elements(protocol, m.direction)
+            for name, t in value_elements(protocol, m)
         ]
         element = error_element(protocol, m)
         if element is not None:
@@ -732,7 +732,7 @@ def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) 
     return "\n".join(lines)
 
 
-def leading_dispatch(ctx: Ctx, lead: Discriminator, values: tuple[tuple[str, object], ...]) -> list[str]:
+def leading_dispatch(ctx: Ctx, lead: Discriminator) -> list[str]:
     """The decode dispatch's lines for messages that share a code (or carry none), picked by their leading constant
     (RTCM 3's message number, Kondo ICS's command bits: lang/model/discriminator.py): the content's first bytes read
     as one integer, shifted and masked, then the message whose value or run of values it is."""
@@ -743,7 +743,7 @@ def leading_dispatch(ctx: Ctx, lead: Discriminator, values: tuple[tuple[str, obj
         f"            lead = {lead_value(lead)};",
     ]
     for low, high, message in lead.ranges():
-        body.append(f"            if ({lead_test(low, high)}) {{ {dec_call(ctx, message, values)} }}")
+        body.append(f"            if ({lead_test(low, high)}) {{ {dec_call(ctx, message)} }}")
     return [*body, f"            return {P}_E_UNKNOWN;"]
 
 
@@ -1132,7 +1132,6 @@ def source(ctx: Ctx) -> str:
     dec_cases: list[str] = []
     for d in directions(protocol):
         rows = []
-        values = value_elements(protocol, d)
         error_first = []
         for code, users in messages_by_code(protocol, d).items():
             key = code_key(P, code)
@@ -1144,11 +1143,11 @@ def source(ctx: Ctx) -> str:
                 error = protocol.error_reply
                 element = error_element(protocol, users[0])
                 assert element is not None
-                at = next(i for i, (name, _) in enumerate(values) if name == error.status)
+                at = next(i for i, (name, _) in enumerate(value_elements(protocol, users[0])) if name == error.status)
                 error_first = [  # told by the status (`error_bits`): the refused request's code as it is
                     f"        if (code >= 0 && ((unsigned long)values[{at}] & {error.bits}UL) != 0u) {{",
                     f"            out->u.{msg_id(users[0])}.{ident(error.element)} = ({_ctype_of(element[1])})code;",
-                    f"            {dec_call(ctx, users[0], values)}",
+                    f"            {dec_call(ctx, users[0])}",
                     "        }",
                 ]
                 continue
@@ -1161,7 +1160,7 @@ def source(ctx: Ctx) -> str:
                     f"        if (code >= 0 && ((unsigned long)code & {error.flag}UL) != 0u) {{",
                     f"            out->u.{msg_id(users[0])}.{ident(error.element)} = "
                     f"({_ctype_of(element[1])})((unsigned long)code & {keep}UL);",
-                    f"            {dec_call(ctx, users[0], values)}",
+                    f"            {dec_call(ctx, users[0])}",
                     "        }",
                 ]
                 continue
@@ -1173,13 +1172,13 @@ def source(ctx: Ctx) -> str:
                     m = sub.request if d == Direction.REQUEST else sub.response
                     if m is not None:
                         label = f"{sub.code}u" if not selector.signed else f"{sub.code}"
-                        body.append(f"            case {label}: {dec_call(ctx, m, values)}")
+                        body.append(f"            case {label}: {dec_call(ctx, m)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
             elif (apart := sized_apart(users, code is None and protocol.framing.by_request(d))) and (
                 lead := discriminator(users)
             ) is not None:
-                body += leading_dispatch(ctx, lead, values)  # messages that share a code: by their leading constant
+                body += leading_dispatch(ctx, lead)  # messages that share a code: by their leading constant
             elif apart:  # requests (replies none of which is the default) that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
                     tests = [f"n >= {u.min_size}u"] if u.min_size else []
@@ -1187,16 +1186,16 @@ def source(ctx: Ctx) -> str:
                         same = u.max_size == u.min_size
                         tests = [f"n == {u.min_size}u"] if same else [*tests, f"n <= {u.max_size}u"]
                     fits = " && ".join(tests) or "1"
-                    body.append(f"            if ({fits}) {{ {dec_call(ctx, u, values)} }}")
+                    body.append(f"            if ({fits}) {{ {dec_call(ctx, u)} }}")
                 body.append(f"            return {P}_E_LENGTH;")
             else:
                 default = next((u for u in users if u.default_reply), users[0])
                 for u in users:
                     if u is not default:
                         body.append(f"            if (expect == {kind_name(ctx, u)}) {{")
-                        body.append(f"                {dec_call(ctx, u, values)}")
+                        body.append(f"                {dec_call(ctx, u)}")
                         body.append("            }")
-                body.append(f"            {dec_call(ctx, default, values)}")
+                body.append(f"            {dec_call(ctx, default)}")
             rows.append(f"        case {key}: {{\n" + "\n".join(body) + "\n        }")
         dec_cases.append(
             f"    case {P}_{d.name}:\n"
@@ -1235,7 +1234,7 @@ def source(ctx: Ctx) -> str:
     for m in msgs:
         mid = msg_id(m)
         layout = protocol.layout(m)
-        values = value_elements(protocol, m.direction)
+        values = value_elements(protocol, m)
         number = protocol.command(m.command).wire_code(m.direction) if layout.has_command else None
         wire_code = f"{number if number is not None else 0}UL"
         xdecls, vchecks = optional.encode_lines(ctx, m.direction) if opt else ([], [])
@@ -2149,7 +2148,6 @@ def refused_decoder(ctx: Ctx, refusals: list[tuple[Direction, int]]) -> tuple[st
     m = next(m for m in messages(protocol) if m.error_reply)
     element = error_element(protocol, m)
     assert element is not None
-    values = value_elements(protocol, m.direction)
     xparam = "const uint8_t *const *extras, " if optional.has_optional(ctx) else ""
     function = "\n".join(
         [
@@ -2160,7 +2158,7 @@ def refused_decoder(ctx: Ctx, refusals: list[tuple[Direction, int]]) -> tuple[st
             "    int r;",
             "    (void)values;",
             f"    out->u.{msg_id(m)}.{ident(element[0])} = ({_ctype_of(element[1])})code;",
-            f"    {dec_call(ctx, m, values)}",
+            f"    {dec_call(ctx, m)}",
             "}",
             "",
         ]
@@ -2309,8 +2307,11 @@ def selector_value(selector: ScalarType, offset: int, byte_order: str) -> str:
     return f"((int64_t)({value}) ^ {sign}) - {sign}"
 
 
-def dec_call(ctx: Ctx, m: Message, values: tuple[tuple[str, object], ...]) -> str:
+def dec_call(ctx: Ctx, m: Message) -> str:
+    """Decode a message of the frame taken apart in its own layout: its content, then the frame values the engine
+    read into `values[]` (its layout's, in order)."""
     mid = msg_id(m)
+    values = value_elements(ctx.protocol, m)
     sets = " ".join(f"out->u.{mid}.{ident(name)} = ({_ctype_of(t)})values[{i}];" for i, (name, t) in enumerate(values))
     sets = f"{sets} {optional.dec_sets(ctx, mid, m.direction)}".strip()
     return f"out->kind = {kind_name(ctx, m)}; r = {ctx.p}__dec_{mid}(c, n, &out->u.{mid}); {sets} return r;"
@@ -2565,7 +2566,7 @@ def json_function(ctx: Ctx, message: Message) -> str:
     ctx.counters.clear()
     body: list[str] = []
     first = True
-    layout = ctx.protocol.framing.layouts[message.direction]
+    layout = ctx.protocol.layout(message)
     for e in layout.value_elements:
         sep = "" if first else ", "
         first = False

@@ -230,7 +230,7 @@ def functions(ctx: Ctx) -> tuple[str, str]:
     decode = f"""
 int {p}_decode_reply(const uint8_t *frame, size_t len, const {p}_msg_t *request, {p}_msg_t *out)
 {{
-    uint8_t pre[{P}_REQUEST_BYTES];
+    uint8_t pre[{P}_REQUEST_BYTES] = {{0u}}; /* zeroed: only n bytes are read, which gcc cannot tell */
     size_t n;
     {p}_kind_t reply;
     if (frame == NULL || out == NULL) {{
@@ -252,7 +252,7 @@ int {p}_decode_reply(const uint8_t *frame, size_t len, const {p}_msg_t *request,
     encode = f"""
 int {p}_encode_reply(const {p}_msg_t *msg, const {p}_msg_t *request, uint8_t *buf, size_t cap, size_t *len)
 {{
-    uint8_t pre[{P}_REQUEST_BYTES];
+    uint8_t pre[{P}_REQUEST_BYTES] = {{0u}}; /* zeroed: only n bytes are read, which gcc cannot tell */
     size_t n;
     {p}_kind_t reply;
     if (msg == NULL || buf == NULL || len == NULL) {{

@@ -17,14 +17,18 @@ from serialspec.backends.c.text_runtime import (
     BEFORE_PARSER,
     CHECKED_READ,
     CHECKED_WRITE,
+    DECIMAL_CHECKED_READ,
+    DECIMAL_CHECKED_WRITE,
     HEAD,
+    LINES_PUSH,
     MIDDLE,
     PARSER,
+    START_PUSH,
     Piece,
     used,
     written,
 )
-from serialspec.backends.common.text_frames import refuse_text_frames
+from serialspec.backends.common.text_frames import C_TAKES, refuse_text_frames
 from serialspec.checksums.base import NoCode
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
@@ -33,7 +37,7 @@ RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "
 
 def refuse(text: TextFrame) -> None:
     """Unsupported naming what of a text spec the C target cannot generate yet."""
-    refuse_text_frames(text)
+    refuse_text_frames(text, C_TAKES)
     if text.checksum is not None:
         try:
             text.checksum.c_code("p")
@@ -67,6 +71,7 @@ class TextC:
         self.protocol, self.text = protocol, text
         self.p, self.P = protocol.name, protocol.name.upper()
         self.limit = text.max_length + len(text.end)
+        self.bare_macros = ""  # replies of values alone: the macros that tell their kinds (bare_decode)
         self.calls: set[str] = set()  # the runtime's helpers the code written calls (text_runtime.used)
 
     def call(self, helper: str) -> str:
@@ -138,6 +143,16 @@ class TextC:
                 f"/* The checksum of the characters between start and marker. */\n{t.checksum.c_code(p).prototype}\n"
             )
         results = ",\n".join(f"    {P}_{r}" + (" = 0" if r == "OK" else "") for r in RESULTS)
+        overlong = (
+            ""
+            if t.start
+            else "    uint8_t overlong; /* frames without a start: the line being read was dropped as too long */\n"
+        )
+        if any(m.values_only for m in t.messages):  # replies of values alone: read as the reply awaited
+            overlong += (
+                f"    {p}_kind_t awaited; /* the reply awaited ({p}_parser_expect), until a response of it */\n"
+                f"    {p}_kind_t asked;   /* the reply of values alone of the request just read */\n"
+            )
         return f"""{banner(self.protocol)}
 #ifndef {P}_H
 #define {P}_H
@@ -240,7 +255,7 @@ typedef struct {{
     {p}_direction_t dir;
     size_t n;
     uint8_t buf[{self.limit + 1}u];
-    uint32_t frames;
+{overlong}    uint32_t frames;
     uint32_t garbage; /* not counted for text frames (always 0) */
     uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
     uint32_t unknown; /* of those, frames with a good checksum and an unknown code ({P}_EVENT_FRAME_UNKNOWN) */
@@ -446,10 +461,98 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
     return {P}_OK;
 }}"""
 
+    def bare_decode(self, bare: list[TextMessage]) -> tuple[str, str, str, str]:
+        """Replies of values alone (`values_only`: ODrive's `r vbus_voltage` answered `24.1`), read as the reply
+        awaited where a frame's first field is no code of its direction (runtime/text.py TextFraming.decode's
+        `reply`): the helpers before the decoder, the decoder's reading of one, encode's dropping of the separator
+        before its first value, and decode_expect's reply awaited."""
+        p, P, t = self.p, self.P, self.text
+        if not bare:
+            return "", "    (void)reply;\n", "", f"{P}_KIND_NONE"
+        cases = []
+        for m in bare:
+            same = [o for o in t.messages if o.code == m.code]
+            labels = "".join(f"    case {P}_{mid(o).upper()}:\n" for o in same)
+            cases.append(f"{labels}        return {P}_{mid(m).upper()};")
+        coded = [m for m in t.messages if not m.values_only]
+        requests = [m for m in t.messages if m.direction.value == "request"]
+        responses = [m for m in t.messages if m.direction.value == "response"]
+
+        def kinds(found: list[TextMessage]) -> str:
+            return " || ".join(f"(kind) == {P}_{mid(m).upper()}" for m in found) or "0"
+
+        coded_cases = [f"    case {P}_{mid(m).upper()}:\n        return dir == {P}_{m.direction.name};" for m in coded]
+        self.bare_macros = f"""/* Replies of values alone (`values_only`): no code, so read as the reply awaited. */
+#define {P}__BARE(kind) ({kinds(bare)})
+#define {P}__IS_REQUEST(kind) ({kinds(requests)})
+#define {P}__IS_RESPONSE(kind) ({kinds(responses)})
+"""
+        helpers = f"""/* The reply of values alone that answers `kind`'s code (its request's, or its own), or none. */
+static {p}_kind_t {p}__bare_reply({p}_kind_t kind)
+{{
+    switch (kind) {{
+{chr(10).join(cases)}
+    default:
+        return {P}_KIND_NONE;
+    }}
+}}
+
+/* 1 when `kind` (what a frame's code names) is a message sent with its code, in `dir`. */
+static int {p}__coded({p}_kind_t kind, {p}_direction_t dir)
+{{
+    switch (kind) {{
+{chr(10).join(coded_cases)}
+    default:
+        return 0;
+    }}
+}}
+
+#if {P}_ENABLE_PARSER
+/* After a message the parser gives (runtime/text.py TextStreamParser._decoded): the reply awaited answered; a
+ * request read, whose reply of values alone is read next. */
+static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
+{{
+    if (out->kind == p->awaited && {P}__IS_RESPONSE(out->kind)) {{
+        p->awaited = {P}_KIND_NONE;
+    }}
+    p->asked = {P}__IS_REQUEST(out->kind) ? {p}__bare_reply(out->kind) : {P}_KIND_NONE;
+}}
+#endif
+
+"""
+        read = f"""    if (reply != {P}_KIND_NONE && dir != {P}_REQUEST && !{p}__coded(kind, dir)) {{
+        /* the reply of values alone awaited: its values from the first field on, no talker */
+        kind = reply;
+        out->talker[0] = '\\0';
+        out->sent = (int32_t)(seps + 1u);
+        c.more = 1;
+        c.pos = 0u;
+    }}
+"""
+        write = f"""    if ({P}__BARE(msg->kind) && !o.full && o.n > {P}__S && o.b[{P}__S] == {P}__SEPARATOR) {{
+        for (i = {P}__S; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
+            o.b[i] = o.b[i + 1u];
+        }}
+        o.n--;
+    }}
+"""
+        return helpers, read, write, f"{p}__bare_reply(expect)"
+
+    def bare_expect(self) -> str:
+        """p_parser_expect where replies of values alone are read as the reply awaited (TextStreamParser.expect)."""
+        p = self.p
+        return f"""
+void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
+{{
+    parser->awaited = reply;
+}}
+"""
+
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
+        bare = [m for m in t.messages if m.values_only]  # replies of values alone (`values_only`)
         end = ", ".join(_byte(c) for c in t.end)
-        special_characters = sorted({t.start, t.separator, t.marker, *t.end})
+        special_characters = sorted({t.start, t.separator, t.marker, *t.end} - {""})
         checked = t.checksum is not None
         checksum, reflects = "", False
         if t.checksum is not None:
@@ -502,17 +605,17 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             f"    case {P}_{mid(m).upper()}:\n"
             f"        if (check && !{P}_ENCODES_{m.direction.name}S) {{\n"
             f"            return {P}_E_ARG; /* left out */\n        }}\n"
-            f"        {self.call('put_text')}(o, {c_text(m.code)}, {len(m.code)}u);\n"
-            f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
+            + ("" if m.values_only else f"        {self.call('put_text')}(o, {c_text(m.code)}, {len(m.code)}u);\n")
+            + f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
             for m in t.messages
         )
         talkers = " && ".join(f'!{p}__is((const uint8_t *)msg->talker, {t.talker}u, "{x}")' for x in t.talkers)
         talker_read = "    talker = 0u;\n    out->talker[0] = '\\0';"
         if t.talker:
             talker_read = f"""    talker = address < {t.talker}u ? address : {t.talker}u;
-    for (i = 0u; i < talker; i++) {{{{
+    for (i = 0u; i < talker; i++) {{
         out->talker[i] = (char)frame[body + i];
-    }}}}
+    }}
     out->talker[talker] = '\\0';"""
         talker_check = f"""    for (i = 0u; i < {t.talker}u; i++) {{
         if (msg->talker[i] == '\\0') {{
@@ -529,9 +632,9 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             ""
             if not t.talker
             else f"""    size_t i;
-    for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{{{
+    for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{
         {self.call("put")}(o, (uint8_t)msg->talker[i]);
-    }}}}"""
+    }}"""
         )
         special = Piece(
             f"""/* The framing's own characters: no field may hold one. */
@@ -543,10 +646,11 @@ static int {p}__special(uint8_t c)
 """,
             "special",
         )
-        parts = (
-            [*HEAD, CHECKED_READ, MIDDLE, CHECKED_WRITE, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
-        )
-        helpers = used([special, *parts, PARSER], self.calls)
+        decimal = t.checksum_format == "decimal"  # written in decimal (G-code's `*71`), not as hex digits
+        read, write = (DECIMAL_CHECKED_READ, DECIMAL_CHECKED_WRITE) if decimal else (CHECKED_READ, CHECKED_WRITE)
+        parts = [*HEAD, read, MIDDLE, write, BEFORE_PARSER] if checked else [*HEAD, MIDDLE, BEFORE_PARSER]
+        push = START_PUSH if t.start else LINES_PUSH  # frames without a start character: every line a frame
+        helpers = used([special, *parts, push, PARSER], self.calls)
 
         def prefixed(pieces: list[Piece]) -> str:
             return written(pieces, helpers).replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
@@ -554,18 +658,38 @@ static int {p}__special(uint8_t c)
         runtime = prefixed(parts)
         # the firmware API beside the parser (parser_api.py), inside the parser's feature switch: before its last
         # #endif (the others close role checks inside functions)
-        body, closing, _ = prefixed([PARSER]).rpartition("}\n#endif\n")
+        body, closing, _ = prefixed([push, PARSER]).rpartition("}\n#endif\n")
         assert closing, "the parser piece ends its feature switch"
         parser = (
             body
             + "}\n"
             + parser_api.push_function(p, P, None)
             + parser_api.frame_function(p)
-            + parser_api.expect_function(p, P, True)
+            + (parser_api.expect_function(p, P, True) if not bare else self.bare_expect())
             + "#endif\n"
         )
         kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
         results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
+        separated = [m for m in t.messages if m.direction.value in t.checksum_separated]
+        separated_dirs = " || ".join(f"(dir) == {P}_{d.upper()}" for d in t.checksum_separated)
+        separated_dirs = f"({separated_dirs})" if separated_dirs else "0"
+        separated_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in separated) or "0"
+        bare_helpers, bare_read, bare_write, expect_reply = self.bare_decode(bare)
+        talker_write_bare = talker_write
+        if bare and talker_write:  # a reply of values alone: no talker written
+            talker_write_bare = f"    if (!{P}__BARE(msg->kind)) {{\n{talker_write}\n    }}"
+        reply_macros = (
+            f"/* the reply of values alone the parser reads next (the reply awaited's, or the last request's) */\n"
+            f"#define {P}__REPLY(p) ((p)->awaited != {P}_KIND_NONE ? {p}__bare_reply((p)->awaited) : (p)->asked)\n"
+            f"#define {P}__ANSWERED(p, out) {p}__answered((p), (out))\n"
+            f"#define {P}__INIT_REPLY(p) ((p)->awaited = {P}_KIND_NONE, (p)->asked = {P}_KIND_NONE)\n"
+            + self.bare_macros
+            if bare
+            else f"#define {P}__REPLY(p) {P}_KIND_NONE\n#define {P}__ANSWERED(p, out) ((void)0)\n"
+            f"#define {P}__INIT_REPLY(p) ((void)0)\n"
+        )
+        start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
+        room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
 #include "{p}.h"
 
@@ -578,14 +702,15 @@ static int {p}__special(uint8_t c)
 #define {P}__DECODES(dir) ((dir) == {P}_REQUEST ? {P}_DECODES_REQUESTS : (dir) == {P}_RESPONSE && {P}_DECODES_RESPONSES)
 
 /* ---- the frame, as the spec says ({comment(t.description or "")}) ---- */
-#define {P}__START {_byte(t.start)}            /* {comment(repr(t.start))} */
-#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
+#define {P}__S {len(t.start)}u /* the start character's bytes: 1, or 0 where every line is a frame */
+{start}#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
 #define {P}__MARKER {_byte(t.marker)}          /* {comment(repr(t.marker))}: the checksum follows */
 #define {P}__CHECKED {int(checked)}            /* a checksum is written */
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
+#define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
 #define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
-#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
+{reply_macros}#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
 static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
 #endif
 
@@ -629,7 +754,10 @@ static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir
     return {P}_KIND_NONE;
 }}
 
-static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
+{bare_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's first field is
+ * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
+                       {p}_msg_t *out)
 {{
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
@@ -645,7 +773,7 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}
-    r = {p}__unframe(frame, len, &body, &n, &unchecked);
+    r = {p}__unframe(frame, len, dir, &body, &n, &unchecked);
     if (r != {P}_OK) {{
         return r;
     }}
@@ -658,15 +786,15 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     }}
 {talker_read}
     kind = {p}__lookup(frame + body + talker, address - talker, dir);
-    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
-        return {P}_E_UNKNOWN;
-    }}
     out->sent = (int32_t)seps;
-    out->unchecked = unchecked != 0;
     c.b = frame + body;
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+        return {P}_E_UNKNOWN;
+    }}
+    out->unchecked = unchecked != 0;
     switch (kind) {{
 {dec_cases}
     case {P}_KIND_NONE:
@@ -682,12 +810,12 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
 
 int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
 {{
-    return {p}__decode(frame, len, dir, expect, out);
+    return {p}__decode(frame, len, dir, expect, {expect_reply}, out);
 }}
 
 int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out)
 {{
-    return {p}__decode(frame, len, dir, {P}_KIND_NONE, out);
+    return {p}__decode(frame, len, dir, {P}_KIND_NONE, {P}_KIND_NONE, out);
 }}
 #endif
 
@@ -696,7 +824,7 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 /* Talker, code and fields (range-checked when `check`), from o's position on. */
 static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
 {{
-{talker_write}
+{talker_write_bare}
     switch (msg->kind) {{
 {enc_cases}
     case {P}_KIND_NONE:
@@ -736,12 +864,9 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
         return {P}_E_ARG;
     }}
 {talker_check}
-    if (cap < 1u) {{
-        return {P}_E_BUFFER;
-    }}
-    o.b = buf;
+{room}    o.b = buf;
     o.cap = cap;
-    o.n = 1u;
+    o.n = {P}__S;
     o.full = 0;
     r = {p}__body(msg, &o, 1);
     if (r != {P}_OK) {{
@@ -753,7 +878,8 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
             return r;
         }}
     }}
-    return {p}__frame(&o, len, msg->unchecked);
+{bare_write}
+    return {p}__frame(&o, len, msg->unchecked, {separated_kinds});
 }}
 #endif
 

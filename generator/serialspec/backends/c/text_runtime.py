@@ -641,22 +641,26 @@ static double pfx__angle_value(const pfx_angle_t *a)
     ),
     Piece(
         r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
- * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. */
-static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, int *unchecked)
+ * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
+ * separator before the marker, it is no part of the fields. */
+static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
     size_t i, end = len, stop;
     *unchecked = 0;
-    for (i = 0u; i < len; i++) {
+    (void)dir;
+    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
+        end = len - (sizeof(pfx__end) - 1u);
+    }
+    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
         }
     }
-    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
-        end = len - (sizeof(pfx__end) - 1u);
-    }
+#if PFX__S
     if (end < 1u || f[0] != PFX__START) {
         return PFX_E_FRAME;
     }
+#endif
     stop = end;
 """,
         "",
@@ -665,28 +669,21 @@ static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n, i
 )
 
 # the checksum read and written where the protocol has one (text.py leaves them out otherwise)
-CHECKED_READ = Piece(
+_CHECKED_READ = Piece(
     r"""#if PFX__CHECKED
     {
         size_t at = end, k;
         uint32_t written = 0u;
-        while (at > 1u && f[at - 1u] != PFX__MARKER) {
+        while (at > PFX__S && f[at - 1u] != PFX__MARKER) {
             at--;
         }
-        if (at > 1u) {
-            if (end - at != PFX__DIGITS) {
+        if (at > PFX__S) {
+@DIGITS_READ@            stop = at - 1u;
+            if (written != pfx__checksum(f + PFX__S, stop - PFX__S)) {
                 return PFX_E_CHECKSUM;
             }
-            for (k = at; k < end; k++) {
-                int v = pfx__hex_value(f[k]);
-                if (v < 0) {
-                    return PFX_E_CHECKSUM;
-                }
-                written = (written << 4) | (uint32_t)v;
-            }
-            stop = at - 1u;
-            if (written != pfx__checksum(f + 1u, stop - 1u)) {
-                return PFX_E_CHECKSUM;
+            if (PFX__SEPARATED(dir) && stop > PFX__S && f[stop - 1u] == PFX__SEPARATOR) {
+                stop--; /* the separator before the marker, covered by the checksum */
             }
         } else if (PFX__REQUIRED) {
             return PFX_E_CHECKSUM;
@@ -699,20 +696,44 @@ CHECKED_READ = Piece(
     needs=("hex_value", "checksum"),
 )
 
+HEX_READ = """            if (end - at != PFX__DIGITS) {
+                return PFX_E_CHECKSUM;
+            }
+            for (k = at; k < end; k++) {
+                int v = pfx__hex_value(f[k]);
+                if (v < 0) {
+                    return PFX_E_CHECKSUM;
+                }
+                written = (written << 4) | (uint32_t)v;
+            }
+"""
+DECIMAL_READ = """            if (end - at < 1u || end - at > 3u) { /* 1 to 3 decimal digits */
+                return PFX_E_CHECKSUM;
+            }
+            for (k = at; k < end; k++) {
+                if (f[k] < 0x30u || f[k] > 0x39u) {
+                    return PFX_E_CHECKSUM;
+                }
+                written = written * 10u + (uint32_t)(f[k] - 0x30u);
+            }
+"""
+CHECKED_READ = Piece(_CHECKED_READ.text.replace("@DIGITS_READ@", HEX_READ), needs=("hex_value", "checksum"))
+DECIMAL_CHECKED_READ = Piece(_CHECKED_READ.text.replace("@DIGITS_READ@", DECIMAL_READ), needs=("checksum",))
+
 MIDDLE = Piece(
-    r"""    *body = 1u;
-    *n = stop - 1u;
+    r"""    *body = PFX__S;
+    *n = stop - PFX__S;
     return PFX_OK;
 }
 #endif
 
 #if PFX_ENABLE_ENCODE
-/* Exactly `sent` fields after the address (o->b[1..n): the address, then each field after a separator): the fields
+/* Exactly `sent` fields after the address (o->b[PFX__S..n): the address, then each field after a separator): the fields
  * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. */
 static int pfx__trim(pfx__out_t *o, size_t sent)
 {
     size_t i, k, fields = 0u;
-    for (i = 1u; i < o->n; i++) {
+    for (i = PFX__S; i < o->n; i++) {
         if (o->b[i] == PFX__SEPARATOR && ++fields > sent) {
             break;
         }
@@ -732,29 +753,53 @@ static int pfx__trim(pfx__out_t *o, size_t sent)
     return PFX_OK;
 }
 
-/* The frame around fields already written from buf[1]: the start before them, checksum (unless `unchecked`: a
+/* The frame around fields already written from buf[PFX__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked)
+static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated)
 {
     size_t k;
+    (void)separated;
+#if PFX__S
     o->b[0] = PFX__START;
+#endif
     (void)unchecked;
 """,
     needs=("trim", "put", "frame"),
 )
 
-CHECKED_WRITE = Piece(
+_CHECKED_WRITE = Piece(
     r"""#if PFX__CHECKED
     if (!unchecked || PFX__REQUIRED) {
-        uint32_t sum = pfx__checksum(o->b + 1u, o->n - 1u);
+        uint32_t sum;
+        if (separated) { /* the separator before the marker, covered by the checksum */
+            pfx__put(o, PFX__SEPARATOR);
+        }
+        sum = pfx__checksum(o->b + PFX__S, o->n - PFX__S);
         pfx__put(o, PFX__MARKER);
-        for (k = PFX__DIGITS; k > 0u; k--) {
+@DIGITS_WRITE@    }
+#endif
+""",
+    needs=("checksum", "put"),
+)
+
+HEX_WRITE = """        for (k = PFX__DIGITS; k > 0u; k--) {
             uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
             pfx__put(o, (uint8_t)(nibble < 10u ? 0x30u + nibble : 0x37u + nibble));
         }
-    }
-#endif
-""",
+"""
+DECIMAL_WRITE = """        for (k = 0u; k == 0u || sum > 0u; k++) { /* decimal digits, backwards */
+            digits[k] = (uint8_t)(0x30u + sum % 10u);
+            sum /= 10u;
+        }
+        while (k > 0u) {
+            pfx__put(o, digits[--k]);
+        }
+"""
+CHECKED_WRITE = Piece(_CHECKED_WRITE.text.replace("@DIGITS_WRITE@", HEX_WRITE), needs=("checksum", "put"))
+DECIMAL_CHECKED_WRITE = Piece(
+    _CHECKED_WRITE.text.replace("@DIGITS_WRITE@", DECIMAL_WRITE).replace(
+        "        uint32_t sum;\n", "        uint32_t sum;\n        uint8_t digits[10];\n"
+    ),
     needs=("checksum", "put"),
 )
 
@@ -774,8 +819,8 @@ BEFORE_PARSER = Piece(
     needs=("put",),
 )
 
-# the line parser (text.py writes it after the messages' code)
-PARSER = Piece(
+# the line parser (text.py writes one of the two pushes, then PARSER, after the messages' code)
+START_PUSH = Piece(
     r"""#if PFX_ENABLE_PARSER
 /* Where `c` is in b[from..n), n if nowhere. */
 static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
@@ -838,9 +883,10 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
             return 0;
         }
         {
-            int r = pfx__decode(p->buf, end + k, p->dir, PFX_KIND_NONE, out);
+            int r = pfx__decode(p->buf, end + k, p->dir, PFX_KIND_NONE, PFX__REPLY(p), out);
             pfx__drop(p, end + k);
             if (r == PFX_OK) {
+                PFX__ANSWERED(p, out);
                 p->frames++;
                 p->frame = p->buf; /* it ends with the byte just pushed: nothing held after it */
                 p->frame_len = end + k;
@@ -857,24 +903,111 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
     }
 }
 
-void pfx_parser_init(pfx_parser_t *parser, pfx_direction_t dir)
-{
-    parser->dir = dir;
-    parser->n = 0u;
-    parser->frames = 0u;
-    parser->garbage = 0u;
-    parser->errors = 0u;
-    parser->unknown = 0u;
-    parser->frame = NULL;
-    parser->frame_len = 0u;
-}
-
 void pfx_parser_gap(pfx_parser_t *parser)
 {
     if (parser->n > 0u) { /* it begins with the start character */
         parser->errors++;
     }
     parser->n = 0u;
+}
+
+""",
+    needs=("same", "decode"),
+)
+
+LINES_PUSH = Piece(
+    r"""#if PFX_ENABLE_PARSER
+/* One byte in: runtime/text.py TextStreamParser.feed of that byte, for frames without a start character (its
+ * _lines: every line a frame). A line longer than the spec's max_length is dropped to its end (counted in errors);
+ * a blank line is skipped; CR and LF before a line (the rest of a longer line ending) are not part of it; a line
+ * that does not decode is dropped. */
+static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
+{
+    const size_t k = sizeof(pfx__end) - 1u;
+    size_t from = 0u, i;
+    int r;
+    if (p->n < PFX__LIMIT + 1u) {
+        p->buf[p->n++] = byte;
+    }
+    if (p->n < k || !pfx__same(p->buf + p->n - k, pfx__end, k)) { /* byte by byte: an ending is at the tail */
+        if (p->n > PFX__LIMIT) {
+            p->errors++;
+            for (i = 0u; i + 1u < k; i++) { /* keep what may begin a line ending */
+                p->buf[i] = p->buf[p->n - (k - 1u) + i];
+            }
+            p->n = k - 1u;
+            p->overlong = 1u;
+        }
+        return 0;
+    }
+    if (p->overlong) { /* the rest of a line already dropped */
+        p->overlong = 0u;
+        p->n = 0u;
+        return 0;
+    }
+    for (i = 0u; i < p->n - k; i++) {
+        uint8_t c = p->buf[i];
+        if (c != 0x20u && (c < 0x09u || c > 0x0Du)) {
+            break;
+        }
+    }
+    if (i == p->n - k) { /* a blank line */
+        p->n = 0u;
+        return 0;
+    }
+    while (p->buf[from] == 0x0Du || p->buf[from] == 0x0Au) {
+        from++;
+    }
+    r = pfx__decode(p->buf + from, p->n - from, p->dir, PFX_KIND_NONE, PFX__REPLY(p), out);
+    p->frame = p->buf + from; /* it ends with the byte just pushed: nothing held after it */
+    p->frame_len = p->n - from;
+    p->n = 0u;
+    if (r == PFX_OK) {
+        PFX__ANSWERED(p, out);
+        p->frames++;
+        return 1;
+    }
+    p->errors++;
+    if (r == PFX_E_UNKNOWN) { /* a good checksum, an unknown code */
+        p->unknown++;
+        return 2;
+    }
+    return 0;
+}
+
+void pfx_parser_gap(pfx_parser_t *parser)
+{
+    size_t i;
+    int begun = 0;
+    for (i = 0u; i < parser->n; i++) { /* a line begun: more than line-ending bytes */
+        begun |= parser->buf[i] != 0x0Du && parser->buf[i] != 0x0Au;
+    }
+    if (begun && !parser->overlong) {
+        parser->errors++;
+    }
+    parser->n = 0u;
+    parser->overlong = 0u;
+}
+
+""",
+    needs=("same", "decode"),
+)
+
+PARSER = Piece(
+    r"""void pfx_parser_init(pfx_parser_t *parser, pfx_direction_t dir)
+{
+    parser->dir = dir;
+    parser->n = 0u;
+#if !PFX__S
+    parser->overlong = 0u;
+#endif
+    PFX__INIT_REPLY(parser);
+    parser->frames = 0u;
+    parser->garbage = 0u;
+    parser->errors = 0u;
+    parser->unknown = 0u;
+    parser->frame = NULL;
+    parser->frame_len = 0u;
 }
 
 size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pfx_msg_t *out, bool *got)
@@ -896,5 +1029,4 @@ size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pf
 }
 #endif
 """,
-    needs=("find", "find_end", "same", "drop", "push", "decode"),
 )

@@ -3,27 +3,36 @@ two say the same one line (backends.Unsupported) for the same spec."""
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
+# what of the list the C target generates (its Wireshark dissector does not yet)
+C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end"})
 
-def refuse_text_frames(text: TextFrame) -> None:
-    """Unsupported naming the first text feature neither the C nor the Wireshark target generates."""
-    if not text.start:
+
+def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
+    """Unsupported naming the first text feature of the list the target does not generate; `takes`: the features of
+    it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
+    "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
+    with bytes above 0x7F)."""
+    if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
-    if any(c > "\x7f" for c in text.end):
+    if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
     if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
         raise Unsupported("a text field to the end of the line (`size: rest`)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
-    if any(m.values_only for m in text.messages):  # each line alone: a line of values names no message
+    # (a target that reads each line alone: a line of values names no message)
+    if any(m.values_only for m in text.messages) and "values_only" not in takes:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
-    if text.checksum is not None and text.checksum_format == "decimal":
+    if text.checksum is not None and text.checksum_format == "decimal" and "decimal" not in takes:
         raise Unsupported("a text checksum written in decimal (`format: decimal`)")
     if text.checksum is not None and text.checksum_directions != ("request", "response"):
         raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
-    if text.checksum is not None and text.checksum_separated:
+    if text.checksum is not None and text.checksum_separated and "separated" not in takes:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")
     if text.response_start:
         raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "b0ac52e8cd67497c4be40e37ffed7cbcc86dab3dd909edb19a5edd534d393581"
+#define HIWONDER_RRC_SPEC_SHA256 "f8802b28fdf6e4311a884ca49f044c283f5538ec99fb3b0fe873fb0a9e87ce65"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

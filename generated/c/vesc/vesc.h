@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "ea4e7fac7692c5c061b1e6e047e2bb3373e60fa10d2d64a5dc2f8e71e4651eee"
+#define VESC_SPEC_SHA256 "67674236cda06b8ef4380a9a0b5d609694e8ba8ef0787116a537be5b2383288f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -91,6 +91,7 @@ local LAYOUTS = {
           refin = false,
           refout = false,
           xorout = 0,
+          data_bits = 8,
         },
         description = "CRC-8/DVB-S2 of the type and the payload.",
       },
@@ -1228,12 +1229,13 @@ CHECKSUMS["crc"] = function(spec, size, data)
   local width = spec.width
   local top, crc_mask = lshift(1, width - 1), width_mask(width)
   local crc = spec.init
+  local bits = spec.data_bits
   for i = 1, #data do
-    local byte = data:byte(i)
+    local byte = band(data:byte(i), width_mask(bits))
     if spec.refin then
-      byte = reflect(byte, 8)
+      byte = reflect(byte, bits)
     end
-    for bit = 7, 0, -1 do
+    for bit = bits - 1, 0, -1 do
       local feedback = band(crc, top) ~= 0
       if band(rshift(byte, bit), 1) == 1 then
         feedback = not feedback

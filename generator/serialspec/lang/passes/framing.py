@@ -12,6 +12,8 @@ from typing import Any, Literal
 from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
 from serialspec.checksums.seed import Seeded
+from serialspec.checksums.seven_bit import SevenBitWire
+from serialspec.encodings import seven_bit
 from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.grammar import FRAME_ELEMENT, Str
@@ -238,6 +240,7 @@ class FramingPass(FieldResolver):
             ("ok", "status"),
             ("truncate", "content"),
             ("from_request", "checksum"),
+            ("encoding", "checksum"),
             ("size", "optional"),
             ("present_if", "optional"),
             ("code", "command"),
@@ -272,12 +275,16 @@ class FramingPass(FieldResolver):
     ) -> Checksum:
         if not item.get("covers"):
             raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
+        seven = item.get("encoding") == seven_bit.NAME  # the value sent 7 bits a byte (Kangaroo's CRC-14)
+        bits = 7 * scalar.size if seven else 0
         try:
             algorithm = checksums.from_spec(
-                item, scalar.size, scalar.name, lambda keys, message: self.error((*path, *keys), message)
+                item, scalar.size, scalar.name, lambda keys, message: self.error((*path, *keys), message), bits
             )
         except ChecksumProblem as problem:
             raise self.fail((*path, *problem.keys), problem.message) from None
+        if seven:
+            algorithm = SevenBitWire(algorithm, scalar.size)
         return Checksum(algorithm, "", "", scalar, endian, name)
 
     def seeded(self, checksum: Checksum, elements: list[FrameElement], a: int, b: int, path: Path) -> Checksum:

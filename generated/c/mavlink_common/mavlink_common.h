@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "9b898e0278f813b2a2f39dedb4cf09869bb6993c9b0d2b555aaf374a649b3c6b"
+#define MAVLINK_COMMON_SPEC_SHA256 "6211d860a0b1d658f1d853bc7c71fb21e0fab677993989c22cc968d20450cabd"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

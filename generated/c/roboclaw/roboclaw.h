@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "d47b3b2f23be81b0607aff15618252c69a3160a1d43e6a5f1b463232ef90fcd7"
+#define ROBOCLAW_SPEC_SHA256 "ab2c76a17640fce8c212d563f95ce04fda3ed3afb4c5c9a62c90e1ddfe719091"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

@@ -1113,8 +1113,11 @@ FRAME_ELEMENT = Obj(
             ),
         ),
         "type": Str(
-            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q).",
-            choices=(*SCALAR_TYPES, "u24"),
+            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q); u4 "
+            "for an address, command, status or value sent as ONE hex digit inside a hex_ascii span, before the "
+            "content (Victron VE.Direct HEX: `:`, the command as one digit, then bytes as pairs: `command: {role: "
+            "command, type: u4}`); a checksum takes it in as a byte 0..15.",
+            choices=(*SCALAR_TYPES, "u24", "u4"),
         ),
         "endian": Str(
             "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",

@@ -642,6 +642,8 @@ class FramingPass(FieldResolver):
             and (final.size == 1 or final.endian == "<")
             and names.index(checksums[0].first) <= content_index <= names.index(checksums[0].last)
             and all((e.size or 0) <= 1 or e.endian == "<" for e in elements)
+            # the classic stream format keys frames by a one-byte code (SBP's u16 message type: the frame engine)
+            and all(e.size == 1 for e in elements if e.role == "command")
             # constant bit fields in a value (a sync nibble): the general engine checks them (Element.need)
             and not any(fixed_bits(e.bits)[0] for e in elements)
         )

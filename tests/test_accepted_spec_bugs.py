@@ -76,9 +76,8 @@ def test_decode_without_a_direction_takes_the_one_direction_a_frame_decodes_in(
     assert capsys.readouterr().err.strip() == "serialspec decode: aa 09 01 05: unknown command 0x09"
 
 
-def test_yaml_merge_keys_bring_in_the_anchored_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """`<<: *common` gave a traceback (no constructor for tag:yaml.org,2002:merge)."""
-    body = """\
+# a frame of a header AA, a command, a length, the content and a sum of the command and content
+AA_FRAMING = """\
 framing:
   elements:
     header: {role: header, value: "AA"}
@@ -86,6 +85,14 @@ framing:
     length: {role: length, type: u8}
     content: {role: content}
     checksum: {role: checksum, type: u8, algorithm: sum, covers: [command, content]}
+"""
+
+
+def test_yaml_merge_keys_bring_in_the_anchored_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`<<: *common` gave a traceback (no constructor for tag:yaml.org,2002:merge)."""
+    body = (
+        AA_FRAMING
+        + """\
 fields:
   common: &common
     type: u8
@@ -100,11 +107,37 @@ commands:
           description: first
         b: {<<: *common, range: [0, 5]}
 """
+    )
     path = spec(tmp_path, "mergek", body)
     assert main(["encode", path, "--json", '{"command": "one", "fields": {"a": 3, "b": 4}}']) == 0
     assert capsys.readouterr().out.strip() == "aa 01 02 03 04 0a"
     assert main(["encode", path, "--json", '{"command": "one", "fields": {"a": 3, "b": 7}}']) == 1
     assert capsys.readouterr().err.strip() == "serialspec encode: one request: b = 7 is outside its range 0..5"
+
+
+def test_merged_fields_stand_where_the_merge_key_stands(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`{kind: u8, <<: *tail}` put the merged fields first (PyYAML's order), so `kind` went on the wire after them,
+    silently (an EnOcean telegram's data byte after its sender id); a key given beside them that they hold too keeps
+    their place, as RTCM 3's `message_number` overriding its station's."""
+    body = (
+        AA_FRAMING
+        + """\
+commands:
+  one:
+    code: 1
+    request:
+      fields: {kind: u8, <<: &tail {a: u8, b: u8}, c: u8}
+  two:
+    code: 2
+    request:
+      fields: {<<: *tail, a: {type: u8, const: 9}}
+"""
+    )
+    path = spec(tmp_path, "mergeo", body)
+    assert main(["encode", path, "--json", '{"command": "one", "fields": {"kind": 1, "a": 2, "b": 3, "c": 4}}']) == 0
+    assert capsys.readouterr().out.strip() == "aa 01 04 01 02 03 04 0f"
+    assert main(["encode", path, "--json", '{"command": "two", "fields": {"b": 3}}']) == 0
+    assert capsys.readouterr().out.strip() == "aa 02 02 09 03 10"
 
 
 def test_encode_a_reply_whose_direction_has_no_address_or_command(

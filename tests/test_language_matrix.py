@@ -1404,7 +1404,7 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert {"rest", "int", "str", "expression"} - used["size"] == set()
     assert {"rest", "int", "str", "expression"} - used["count"] == set()
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
-    assert {"u8", "u16", "u24"} - used["element type"] == set()
+    assert {"u8", "u16", "u24", "u4"} - used["element type"] == set()
     assert any(bit_run.width(t) for t in used["type"])  # a bit field (uN/iN of another width)
     assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
 

@@ -113,15 +113,17 @@ def test_every_algorithm_documents_its_options() -> None:
 
 def test_the_registry_imports_nothing_of_the_generator() -> None:
     """Generated code imports the algorithms' runtime functions from their modules, and the runtime wheel ships the
-    package without the generator: its modules import the standard library, each other and the runtime's value
-    classes (serialspec.runtime.values, which the runtime wheel ships beside them) only."""
+    package without the generator: its modules import the standard library, each other, the integer encodings
+    (serialspec.encodings, which import nothing of the generator either) and the runtime's value classes
+    (serialspec.runtime.values; the runtime wheel ships both beside them) only."""
     folder = Path(importlib.import_module("serialspec.checksums").__file__ or "").parent
     for path in sorted(folder.glob("*.py")):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
             names += [node.module or ""] if isinstance(node, ast.ImportFrom) else []
             for name in names:
-                allowed = name.startswith("serialspec.checksums") or name == "serialspec.runtime.values"
+                allowed = name.startswith(("serialspec.checksums", "serialspec.encodings"))
+                allowed = allowed or name == "serialspec.runtime.values"
                 assert name.split(".")[0] != "serialspec" or allowed, (path.name, name)
 
 

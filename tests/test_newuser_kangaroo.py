@@ -1,20 +1,19 @@
-"""Dimension Engineering Kangaroo x2 packet serial (tests/specs/kangaroo.yaml), written from the user docs alone:
-a strict xfail. No PyPI peer (PyPI's `kangaroo*` packages are unrelated); the peer is Dimension Engineering's own
-Arduino library (KangarooCRC, KangarooCommandWriter), whose rules this test implements to make the golden frames:
-its CRC's residue over a whole packet is the library's KANGAROO_CRC_GOOD_VALUE (0x307E), so the frames are right.
+"""Dimension Engineering Kangaroo x2 packet serial (tests/specs/kangaroo.yaml), written from the user docs alone.
+No PyPI peer (PyPI's `kangaroo*` packages are unrelated); the peer is Dimension Engineering's own Arduino library
+(KangarooCRC, KangarooCommandWriter), whose rules this test implements to make the golden frames: its CRC's residue
+over a whole packet is the library's KANGAROO_CRC_GOOD_VALUE (0x307E), so the frames are right.
 
-Three gaps, each precise:
+Two gaps closed here, one left:
 1. The CRC runs over the LOW 7 BITS of each byte (`crc ^= byte & 0x7F`, then 7 shifts, reflected, polynomial 0x22F0
-   reflected = 0x03D1, init and xorout 0x3FFF): the catalogue parameters of `crc:` describe byte-wise CRCs, 8 bits a
-   byte, and the address byte (128..135) has bit 7 set, so no parameters give these values.
-2. The 14-bit CRC is sent as two 7-bit bytes, low first: `encoding: seven_bit` is a field's key, not a checksum
-   element's (the loader: `unknown key 'encoding'`).
+   reflected = 0x03D1, init and xorout 0x3FFF): `crc: {..., data_bits: 7}` now.
+2. The 14-bit CRC is sent as two 7-bit bytes, low first: `encoding: seven_bit` on the checksum element now.
 3. Numbers are bit-packed (the value shifted left with the sign in bit 0, then 6 bits a byte, bit 6 marking more):
-   the language has no variable-length integer, so a spec can only carry them as bytes."""
+   the language has no variable-length integer, so the spec carries them as bytes (a strict xfail below)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 from serialspec.lang import load_protocol
@@ -66,24 +65,101 @@ def test_the_librarys_rules() -> None:
     assert byte_wise_crc14(start[:-2]) != kangaroo_crc(start[:-2])  # gap 1: no byte-wise CRC gives it
 
 
-def test_what_the_loader_says() -> None:
-    with pytest.raises(SpecErrors, match=r"framing\.elements\.crc\.encoding: unknown key 'encoding'"):
-        load_protocol(SPEC)
+@pytest.fixture(scope="module")
+def kangaroo(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    from conftest import generate_afresh
+
+    return generate_afresh(SPEC, tmp_path_factory, "kangaroo")
+
+
+@pytest.mark.parametrize(
+    ("frame", "name", "fields"),
+    [
+        (packet(128, 0x20, b"1\x00"), "StartRequest", {"address": 128, "channel": ord("1"), "flags": 0}),
+        (
+            packet(129, 0x24, b"2\x00\x01" + bit_packed(1000)),
+            "MoveRequest",
+            {"address": 129, "channel": ord("2"), "flags": 0, "motion": 1, "values": bit_packed(1000)},
+        ),
+        (
+            packet(135, 0x24, b"D\x00\x02" + bit_packed(-1)),
+            "MoveRequest",
+            {"address": 135, "channel": ord("D"), "flags": 0, "motion": 2, "values": bit_packed(-1)},
+        ),
+        (
+            packet(128, 0x23, b"1\x00\x01"),
+            "StatusRequest",
+            {"address": 128, "channel": ord("1"), "flags": 0, "query": 1},
+        ),
+    ],
+)
+def test_the_librarys_packets_decode_and_re_encode(
+    kangaroo: ModuleType, frame: bytes, name: str, fields: dict[str, object]
+) -> None:
+    message = kangaroo.decode(frame, kangaroo.Direction.REQUEST)
+    assert message == getattr(kangaroo, name)(**fields)
+    assert kangaroo.encode(message) == frame
+
+
+def test_a_reply_decodes_and_a_bad_crc_or_a_high_bit_is_refused(kangaroo: ModuleType) -> None:
+    from serialspec.runtime.errors import ChecksumError
+
+    frame = packet(128, 0x43, b"1\x00\x01" + bit_packed(-1))
+    reply = kangaroo.decode(frame, kangaroo.Direction.RESPONSE)
+    assert (reply.address, reply.channel, reply.query, reply.value) == (128, ord("1"), 1, bit_packed(-1))
+    assert kangaroo.encode(reply) == frame
+    for bad in (frame[:-1] + bytes([frame[-1] ^ 0x01]), frame[:-1] + bytes([frame[-1] | 0x80])):
+        with pytest.raises(ChecksumError):
+            kangaroo.decode(bad, kangaroo.Direction.RESPONSE)
+
+
+def test_the_stream_parser_finds_packets_among_noise(kangaroo: ModuleType) -> None:
+    frames = [packet(128, 0x20, b"1\x00"), packet(130, 0x24, b"T\x00\x02" + bit_packed(-300))]
+    parser = kangaroo.StreamParser(kangaroo.Direction.REQUEST)
+    got = []
+    for byte in b"\x7f\x01" + frames[0] + b"\x00" + frames[1]:
+        got += parser.feed(bytes([byte]))
+    assert [kangaroo.encode(m) for m in got] == frames
 
 
 @pytest.mark.xfail(
     strict=True,
     raises=SpecErrors,
-    reason="language gaps: a CRC over the low 7 bits of each byte (Kangaroo: 7 shifts a byte), a checksum element "
-    "sent as 7-bit bytes (`encoding` is a field's key only), and bit-packed variable-length numbers (6 bits a byte, "
-    "bit 6 marking more, sign in bit 0)",
+    reason="language gap: bit-packed variable-length numbers (Kangaroo: the value shifted left with the sign in "
+    "bit 0, then 6 bits a byte, lowest first, bit 6 marking more); no `encoding` of a field gives them",
 )
-def test_the_librarys_packets_decode_and_re_encode(tmp_path: Path) -> None:
-    from conftest import generate_and_import
+def test_bit_packed_numbers_as_numbers(tmp_path: Path) -> None:
+    text = SPEC.read_text("utf-8").replace(
+        "values: {type: bytes, size: rest,", "values: {type: i32, encoding: bit_packed,"
+    )
+    assert "bit_packed" in text
+    path = tmp_path / "kangaroo.yaml"
+    path.write_text(text, "utf-8")
+    load_protocol(path)
 
-    load_protocol(SPEC)
-    module = generate_and_import(SPEC, tmp_path, "kangaroo")
-    frame = packet(128, 0x24, b"1\x00\x01" + bit_packed(1000))
-    message = module.decode(frame, module.Direction.REQUEST)
-    assert (message.address, message.channel, message.values) == (128, ord("1"), bit_packed(1000))
-    assert module.encode(message) == frame
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        ("check: 0x1D66, data_bits: 7", "check: 0x1D66", "these parameters give 0x2669 for '123456789'"),
+        ("      encoding: seven_bit\n", "", "a 14-bit CRC does not fill a u16"),
+        ("width: 14,", "width: 16,", "a 16-bit CRC does not fill the 14 bits of a u16 sent 7 bits a byte"),
+        ("data_bits: 7", "data_bits: 9", "data_bits: 9 is outside 1..8"),
+        ("{role: length, type: u8}", "{role: length, type: u8, encoding: seven_bit}", "`encoding` belongs to a chec"),
+    ],
+)
+def test_a_mistake_is_one_line(tmp_path: Path, old: str, new: str, said: str) -> None:
+    from conftest import spec_error
+
+    text = SPEC.read_text("utf-8")
+    assert old in text
+    assert said in spec_error(text.replace(old, new), tmp_path)
+
+
+def test_fletcher_is_not_sent_seven_bits_a_byte(tmp_path: Path) -> None:
+    from conftest import spec_error
+
+    text = SPEC.read_text("utf-8")
+    start, end = text.index("      algorithm: crc\n"), text.index("      covers:")
+    text = text[:start] + "      algorithm: fletcher\n" + text[end:]
+    assert "whole bytes: not 7 bits a byte" in spec_error(text, tmp_path)

@@ -1,17 +1,18 @@
-"""Victron VE.Direct HEX (tests/specs/vedirect_hex.yaml), written from the user docs alone: a strict xfail naming
-the language gap left. The frames are Victron's own (the VE.Direct protocol FAQ: `:70010003E` asks for register
-0x1000, `:7001000C80076` answers 200; `:7FF0F0040` asks for the SOC, 0x0FFF) and the ping `:154`.
-(The brief's `:70001004E` for register 0x0100 is not a valid frame: 0x55 - 7 - 0x00 - 0x01 - 0x00 is 0x4D.)
-PyPI's `vedirect`, `vedirect-m8` and `vedirect-jmfife` read the TEXT protocol (label-TAB-value lines), not HEX;
-no peer there. The checksum (0x55 minus the sum) was a second gap: a sum with a start value, `init`, fixed here."""
+"""Victron VE.Direct HEX (tests/specs/vedirect_hex.yaml), written from the user docs alone. The frames are
+Victron's own (the VE.Direct protocol FAQ: `:70010003E` asks for register 0x1000, `:7001000C80076` answers 200;
+`:7FF0F0040` asks for the SOC, 0x0FFF) and the ping `:154`. (The brief's `:70001004E` for register 0x0100 is not a
+valid frame: 0x55 - 7 - 0x00 - 0x01 - 0x00 is 0x4D.) PyPI's `vedirect`, `vedirect-m8` and `vedirect-jmfife` read
+the TEXT protocol (label-TAB-value lines), not HEX; no peer there. Two gaps once, closed: the checksum (0x55 minus
+the sum), a sum with a start value (`init`), and the command as ONE hex digit inside the hex-ASCII span (`type: u4`
+on the command element)."""
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
+from types import ModuleType
 
 import pytest
-from serialspec.lang import load_protocol
-from serialspec.lang.errors import SpecErrors
 
 SPEC = Path(__file__).parent / "specs" / "vedirect_hex.yaml"
 FAQ = [":70010003E", ":7FF0F0040", ":154"]
@@ -31,33 +32,75 @@ def test_the_faqs_frames_follow_the_faqs_rule() -> None:
     assert victron_checksum(7, bytes.fromhex("000100")) == 0x4D  # not the brief's 0x4E
 
 
-def test_what_the_loader_says_of_the_two_gaps() -> None:
-    """One line, at the key: the message a new user gets is right and points at the gap (`init` on the sum, a
-    second line once, is taken now)."""
-    with pytest.raises(SpecErrors) as caught:
-        load_protocol(SPEC)
-    lines = str(caught.value).splitlines()
-    assert len(lines) == 1, lines
-    assert "framing.elements.command.type: unknown value 'u4'" in lines[0]
+@pytest.fixture(scope="module")
+def vedirect(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    from conftest import generate_afresh
+
+    return generate_afresh(SPEC, tmp_path_factory, "vedirect_hex")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: an element written as ONE hex digit inside a hex_ascii span (VE.Direct's command nibble: "
-    "`:7` then byte pairs; the checksum takes it in as the byte 0x07), where every element of the span is whole "
-    "bytes of two digits each",
-    raises=SpecErrors,
-)
-def test_the_faqs_frames_decode_and_re_encode(tmp_path: Path) -> None:
-    from conftest import generate_and_import
-
-    load_protocol(SPEC)  # today: SpecErrors, the line above
-    module = generate_and_import(SPEC, tmp_path, "vedirect_hex")
-    request = module.decode(b":70010003E\n", module.Direction.REQUEST)
-    assert (request.register, request.flags) == (0x1000, 0)
-    assert module.encode(request) == b":70010003E\n"
-    reply = module.decode(b":7001000C80076\n", module.Direction.RESPONSE)
+def test_the_faqs_frames_decode_and_re_encode(vedirect: ModuleType) -> None:
+    request = vedirect.decode(b":70010003E\n", vedirect.Direction.REQUEST)
+    assert request == vedirect.GetRequest(register=0x1000, flags=0)
+    assert vedirect.encode(request) == b":70010003E\n"
+    reply = vedirect.decode(b":7001000C80076\n", vedirect.Direction.RESPONSE)
     assert reply.value == bytes.fromhex("c800")
+    assert vedirect.encode(reply) == b":7001000C80076\n"
+    assert vedirect.encode(vedirect.GetRequest(register=0x0FFF, flags=0)) == b":7FF0F0040\n"
+    assert vedirect.encode(vedirect.PingRequest()) == b":154\n"
+    assert vedirect.decode(b":7ff0f0040\n", vedirect.Direction.REQUEST).register == 0x0FFF  # lower case taken
+
+
+@pytest.mark.parametrize(
+    "frame",
+    [b":70010003F\n", b":07001000" + b"3E\n", b":70010003\n", b":7G010003E\n"],
+    ids=["checksum", "two-digit-command", "cut-short", "not-hex"],
+)
+def test_a_bad_frame_is_refused_in_one_line(vedirect: ModuleType, frame: bytes) -> None:
+    from serialspec.runtime.errors import DecodeError
+
+    with pytest.raises(DecodeError) as caught:
+        vedirect.decode(frame, vedirect.Direction.REQUEST)
+    assert "\n" not in str(caught.value)
+
+
+def test_the_stream_parser_reads_the_faqs_frames_however_split(vedirect: ModuleType) -> None:
+    stream = b"\x00:70010003E\n:7FF0F0040\nxx:154\n"
+    for size in (1, 3, 7, len(stream)):
+        parser = vedirect.StreamParser(vedirect.Direction.REQUEST)
+        got = [m for i in range(0, len(stream), size) for m in parser.feed(stream[i : i + size])]
+        assert [vedirect.encode(m) for m in got] == [b":70010003E\n", b":7FF0F0040\n", b":154\n"], size
+
+
+def test_the_client_talks_to_the_simulator(vedirect: ModuleType) -> None:
+    from conftest import simulated
+
+    client_module = importlib.import_module("vedirect_hex.client")
+    client_class = next(v for k, v in vars(client_module).items() if k.endswith("Client") and k != "ClientBase")
+    with simulated("vedirect_hex") as path, client_class(path, timeout=2.0) as client:
+        assert client.ping() == 0x4141  # the reply's one field, the version
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        ("  transparency: {method: hex_ascii, span: [command, checksum]}\n", "", "must lie in a hex_ascii span"),
+        (
+            "{method: hex_ascii, span: [command, checksum]}",
+            "{method: hex_ascii, span: [content, checksum]}",
+            "lies in the transparency span, before the content",
+        ),
+        ("checksum: {role: checksum, type: u8,", "checksum: {role: checksum, type: u4,", "u4 is an address's"),
+        ("{role: command, type: u4}", "{role: command, type: u4, range: [0, 16]}", "does not fit u4 (0..15)"),
+        ("method: hex_ascii, span: [command, checksum]}\n", "method: cobs, span: [command, checksum]}\n", "not cobs"),
+    ],
+)
+def test_a_u4_mistake_is_one_line(tmp_path: Path, old: str, new: str, said: str) -> None:
+    from conftest import spec_error
+
+    text = SPEC.read_text("utf-8").replace("end: {role: trailer, value: 0A}", 'end: {role: trailer, value: "00"}')
+    assert old in text  # (a NUL trailer: COBS needs it, hex-ASCII takes it)
+    assert said in spec_error(text.replace(old, new), tmp_path)
 
 
 CHECKSUM_ONLY = """

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "b0ac52e8cd67497c4be40e37ffed7cbcc86dab3dd909edb19a5edd534d393581"
+#define HIWONDER_RRC_SPEC_SHA256 "4723778e42c2fee3d9c5e7338a0be35b9a013ced02b1841a210477f12e9c7919"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -91,6 +91,7 @@ local LAYOUTS = {
           refin = false,
           refout = false,
           xorout = 0,
+          data_bits = 8,
         },
         description = "CRC-8/DVB-S2 of the type and the payload.",
       },
@@ -1228,12 +1229,13 @@ CHECKSUMS["crc"] = function(spec, size, data)
   local width = spec.width
   local top, crc_mask = lshift(1, width - 1), width_mask(width)
   local crc = spec.init
+  local bits = spec.data_bits
   for i = 1, #data do
-    local byte = data:byte(i)
+    local byte = band(data:byte(i), width_mask(bits))
     if spec.refin then
-      byte = reflect(byte, 8)
+      byte = reflect(byte, bits)
     end
-    for bit = 7, 0, -1 do
+    for bit = bits - 1, 0, -1 do
       local feedback = band(crc, top) ~= 0
       if band(rshift(byte, bit), 1) == 1 then
         feedback = not feedback
@@ -1299,6 +1301,16 @@ local function untransform(t, wire)
     if plain == nil then error("bad COBS: not the COBS form of any bytes", 0) end
     return plain
   end
+  if t.method == "hex_ascii" and t.digits then -- the plain bytes at t.digits (offsets) one digit each (u4)
+    if wire:find("[^0-9A-Fa-f]") then error("bad hex-ASCII: not hex digits", 0) end
+    local out, i = {}, 1
+    while i <= #wire do
+      local width = t.digits[#out] and 1 or 2
+      if i + width - 1 > #wire then error("bad hex-ASCII: a byte cut short", 0) end
+      out[#out + 1], i = string.char(tonumber(wire:sub(i, i + width - 1), 16)), i + width
+    end
+    return table.concat(out)
+  end
   if t.method == "hex_ascii" then
     if wire:find("[^0-9A-Fa-f]") or #wire % 2 == 1 then error("bad hex-ASCII: not pairs of hex digits", 0) end
     return (wire:gsub("%x%x", function(pair) return string.char(tonumber(pair, 16)) end))
@@ -1329,9 +1341,10 @@ local function plain_prefix(t, data, pos, count)
       end
     elseif t.method == "hex_ascii" then
       if not data:sub(i, i):find("^%x") then break end -- the digits end: so does the span
-      if i + 1 > #data then return false end
-      if not data:sub(i + 1, i + 1):find("^%x") then return nil end
-      out[#out + 1], n, i = string.char(tonumber(data:sub(i, i + 1), 16)), n + 1, i + 2
+      local width = t.digits and t.digits[n] and 1 or 2 -- a u4 element's byte: one digit
+      if i + width - 1 > #data then return false end
+      if not data:sub(i + width - 1, i + width - 1):find("^%x") then return nil end
+      out[#out + 1], n, i = string.char(tonumber(data:sub(i, i + width - 1), 16)), n + 1, i + width
     else
       local matched = false
       for _, pair in ipairs(t.replace) do

@@ -38,9 +38,10 @@ def owned_keys() -> dict[str, tuple[str, ...]]:
     return owners
 
 
-def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Algorithm:
+def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Algorithm:
     """The algorithm of a checksum element (its keys as the grammar checked them) of `size` bytes of `type_name`.
-    Raises ChecksumProblem for a missing algorithm; `report` takes another algorithm's keys given with it."""
+    `bits`: the value's bits where not 8 a byte (Algorithm.from_spec). Raises ChecksumProblem for a missing
+    algorithm; `report` takes another algorithm's keys given with it."""
     found = algorithms()
     name = raw.get("algorithm")
     if name not in found:
@@ -51,7 +52,7 @@ def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report)
     for key, owners in owned_keys().items():
         if key in raw and name not in owners:
             report((key,), f"`{key}` belongs to `algorithm: {' or '.join(owners)}`, not {name}")
-    return found[name].from_spec(raw, size, type_name, report)
+    return found[name].from_spec(raw, size, type_name, report, bits)
 
 
 def _modules() -> list[str]:

@@ -162,10 +162,12 @@ class Algorithm:
     # -- the language ------------------------------------------------------------------------------------------
 
     @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Algorithm:
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Algorithm:
         """The algorithm of a checksum element `raw` (its keys as the grammar checked them) of `size` bytes of
-        type `type_name`. Raises ChecksumProblem where it cannot be made; `report` takes problems that do not stop
-        it (keys below the element, message)."""
+        type `type_name`; `bits`, the bits of its value where they are not 8 a byte (`encoding: seven_bit`: 7 a
+        byte, which the element keeps of the value computed: an algorithm of a width, a CRC, checks it). Raises
+        ChecksumProblem where it cannot be made; `report` takes problems that do not stop it (keys below the
+        element, message)."""
         raise NotImplementedError
 
     # -- the runtime -------------------------------------------------------------------------------------------
@@ -275,6 +277,33 @@ class Algorithm:
     def worked(self, covered: bytes) -> str:
         """A worked example: how the covered bytes give the checksum, ending in its value."""
         raise NotImplementedError
+
+
+class Wrapping(Algorithm):
+    """An algorithm around another (`inner`, a dataclass field of the subclass): a seed after the covered bytes, a
+    value sent 7 bits a byte. Made by the spec language's framing pass, never named by `algorithm:`."""
+
+    registered = False
+    inner: Algorithm
+
+    @classmethod
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Algorithm:
+        raise NotImplementedError  # made by the spec language's framing pass around an algorithm
+
+    def function_imports(self) -> list[Import]:
+        return [self.function_code()[0], *self.inner.function_imports()]
+
+    def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
+        _, lines = super().python_setup(name)
+        return self.function_imports(), lines
+
+    def title(self) -> str:
+        return self.inner.title()
+
+    def inner_lua(self) -> dict[str, Any] | None:
+        """The inner algorithm and its parameters for the dissector (None where it has no Lua code)."""
+        inner = self.inner
+        return {"algorithm": inner.name, **inner.lua_parameters()} if inner.lua_function() else None
 
 
 def hex_value(value: int, width: int) -> str:

@@ -1,4 +1,5 @@
-"""`algorithm: crc`: a CRC by its catalogue parameters (width, poly, init, refin, refout, xorout; reveng's catalogue).
+"""`algorithm: crc`: a CRC by its catalogue parameters (width, poly, init, refin, refout, xorout; reveng's catalogue),
+and `data_bits` where each byte feeds only its low bits (Dimension Engineering's Kangaroo: 7, on a 7-bit link).
 
 The runtime function is the fastest form there is for the parameters (crc_function); generated codecs call the
 standard library's C function directly where it computes the CRC, and step an 8-bit CRC through its table in line.
@@ -59,14 +60,19 @@ def crc_table(width: int, poly: int, refin: bool) -> tuple[int, ...]:
     return tuple(table)
 
 
-def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
-    """A CRC function from catalogue parameters (width, poly, init, refin, refout, xorout), widths 8..32.
+def crc_function(
+    width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int, data_bits: int = 8
+) -> Callable[[bytes], int]:
+    """A CRC function from catalogue parameters (width, poly, init, refin, refout, xorout), widths 8..32; with
+    `data_bits` below 8, each byte feeds its low `data_bits` bits alone (a bit loop: `_crc_low_bits`).
 
     The fastest form there is for the parameters: the standard library's C code where it computes the same CRC
     (binascii.crc_hqx: poly 0x1021, unreflected, 16 bits; zlib.crc32: poly 0x04C11DB7, reflected, 32 bits), two
     bytes per step for every other 16-bit CRC (`_crc16_words`), else a table-driven loop over the bytes.
     """
     mask = (1 << width) - 1
+    if data_bits != 8:
+        return _crc_low_bits(width, poly, init, refin, refout, xorout, data_bits)
     if crc_in_one_call(width, poly, init, refin, refout, xorout) is not None:
         from binascii import crc_hqx  # imported here: loading binascii costs a codec that does not use it ~0.5 ms
 
@@ -151,6 +157,38 @@ def _crc_bytes(width: int, poly: int, init: int, refin: bool, refout: bool, xoro
             return (value ^ xorout) & mask
 
     return crc
+
+
+def _crc_low_bits(
+    width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int, data_bits: int
+) -> Callable[[bytes], int]:
+    """The CRC where each byte feeds only its low `data_bits` bits (bit 7 of a 7-bit link's bytes left out), bit by
+    bit: reflected, the bits go in lowest first; else highest first."""
+    mask = (1 << width) - 1
+    low = (1 << data_bits) - 1
+    if refin:
+        start, reflected_poly = _reflect(init, width), _reflect(poly, width)
+
+        def crc(data: bytes) -> int:
+            value = start
+            for byte in data:
+                value ^= byte & low
+                for _ in range(data_bits):
+                    value = (value >> 1) ^ reflected_poly if value & 1 else value >> 1
+            return ((value if refout else _reflect(value, width)) ^ xorout) & mask
+
+        return crc
+    shift, top = width - data_bits, 1 << (width - 1)
+
+    def crc_msb(data: bytes) -> int:
+        value = init
+        for byte in data:
+            value ^= (byte & low) << shift
+            for _ in range(data_bits):
+                value = ((value << 1) ^ poly) & mask if value & top else (value << 1) & mask
+        return ((_reflect(value, width) if refout else value) ^ xorout) & mask
+
+    return crc_msb
 
 
 def crc_in_one_call(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> str | None:
@@ -243,6 +281,19 @@ def __getattr__(name: str) -> Callable[[bytes, int], int]:
 
 _PARAMETERS = ("width", "poly", "init", "refin", "refout", "xorout", "check")
 
+#: Dimension Engineering's Kangaroo CRC-14 over the low 7 bits of each byte (a sample here, the language reference's
+#: example of `data_bits`)
+KANGAROO_CRC14 = {
+    "width": 14,
+    "poly": 0x03D1,
+    "init": 0x3FFF,
+    "refin": True,
+    "refout": True,
+    "xorout": 0x3FFF,
+    "check": 0x1D66,
+    "data_bits": 7,
+}
+
 
 @dataclass(frozen=True)
 class Crc(Algorithm):
@@ -254,6 +305,7 @@ class Crc(Algorithm):
     xorout: int
     check: int
     catalogue: str = ""  # the catalogue name, e.g. CRC-16/MODBUS
+    data_bits: int = 8  # the low bits of each byte that it takes in (Kangaroo: 7)
 
     name = "crc"
     summary = "a CRC given by its catalogue parameters in `crc:`"
@@ -272,6 +324,17 @@ class Crc(Algorithm):
                 Key("refout", "bool", "The result is reflected before `xorout`."),
                 Key("xorout", "int", "Value XORed into the result."),
                 Key("check", "int", "The catalogue check value: the CRC of b'123456789'."),
+                Key(
+                    "data_bits",
+                    "int",
+                    "The low bits of each byte that the CRC takes in (default 8): 7 on links whose bytes carry 7 bits "
+                    "(Dimension Engineering's Kangaroo: bit 7 of its address byte is left out, 7 shifts a byte); the "
+                    "check value is then of those bits of '123456789'.",
+                    default=8,
+                    example=7,
+                    minimum=1,
+                    maximum=8,
+                ),
             ),
             required=_PARAMETERS,
         ),
@@ -359,6 +422,31 @@ class Crc(Algorithm):
             },
         ),
         Sample(
+            "a CRC-14 over the low 7 bits of each byte (data_bits 7), sent 7 bits a byte (the element's encoding "
+            "seven_bit), as Dimension Engineering's Kangaroo",
+            "u16",
+            {
+                "crc": KANGAROO_CRC14,
+                "encoding": "seven_bit",
+            },
+        ),
+        Sample(
+            "a CRC-8 over the low 7 bits of each byte, unreflected (data_bits 7)",
+            "u8",
+            {
+                "crc": {
+                    "width": 8,
+                    "poly": 0x07,
+                    "init": 0,
+                    "refin": False,
+                    "refout": False,
+                    "xorout": 0,
+                    "check": 0xAB,
+                    "data_bits": 7,
+                }
+            },
+        ),
+        Sample(
             "CRC-32/ISO-HDLC (zlib.crc32)",
             "u32",
             {
@@ -377,13 +465,21 @@ class Crc(Algorithm):
     )
 
     @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Crc:
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Crc:
         params = raw.get("crc")
         if not params:
             raise ChecksumProblem((), "algorithm crc needs `crc:` with width, poly, init, refin, refout, xorout, check")
-        crc = cls(**{key: params[key] for key in _PARAMETERS}, catalogue=str(params.get("name", "")))
-        if crc.width != size * 8:
-            raise ChecksumProblem(("crc", "width"), f"a {crc.width}-bit CRC does not fill a {type_name}")
+        data_bits = int(params.get("data_bits", 8))
+        if not 1 <= data_bits <= 8:  # the grammar said so already: no check value of such bits to add to it
+            raise ChecksumProblem(("crc", "data_bits"), f"{data_bits} is outside 1..8")
+        crc = cls(
+            **{key: params[key] for key in _PARAMETERS}, catalogue=str(params.get("name", "")), data_bits=data_bits
+        )
+        if crc.width != (bits or size * 8):
+            held = f"the {bits} bits of a {type_name} sent 7 bits a byte" if bits else f"a {type_name}"
+            raise ChecksumProblem(("crc", "width"), f"a {crc.width}-bit CRC does not fill {held}")
+        if data_bits > crc.width:
+            raise ChecksumProblem(("crc", "data_bits"), f"{data_bits} bits a byte do not fit a {crc.width}-bit CRC")
         for key in ("poly", "init", "xorout", "check"):
             if not 0 <= params[key] < 1 << crc.width:
                 raise ChecksumProblem(("crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
@@ -399,12 +495,19 @@ class Crc(Algorithm):
     def parameters_tuple(self) -> tuple[int, int, int, bool, bool, int]:
         return self.width, self.poly, self.init, self.refin, self.refout, self.xorout
 
+    @property
+    def whole_bytes(self) -> bool:
+        """Every bit of each byte goes in (`data_bits` 8): the standard library's and the table's forms apply."""
+        return self.data_bits == 8
+
     def function(self) -> Callable[[bytes], int]:
-        return crc_function(*self.parameters_tuple)
+        return crc_function(*self.parameters_tuple, self.data_bits)
 
     def function_code(self) -> tuple[Import, str]:
+        low = "" if self.whole_bytes else f", data_bits={self.data_bits}"
         return ("serialspec.checksums.crc", "crc_function"), (
-            f"crc_function({self.width}, {self.poly:#x}, {self.init:#x}, {self.refin}, {self.refout}, {self.xorout:#x})"
+            f"crc_function({self.width}, {self.poly:#x}, {self.init:#x}, {self.refin}, {self.refout}, "
+            f"{self.xorout:#x}{low})"
         )
 
     def title(self) -> str:
@@ -413,7 +516,7 @@ class Crc(Algorithm):
     @property
     def stepped(self) -> bool:
         """An 8-bit CRC as generated code computes it in line: `crc = table[crc ^ byte]` (reflected or not)."""
-        return self.width == 8 and self.refin == self.refout
+        return self.width == 8 and self.refin == self.refout and self.whole_bytes
 
     def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
         if self.stepped:  # python_lines' table (python_call calls the function)
@@ -421,15 +524,20 @@ class Crc(Algorithm):
             return [("serialspec.checksums.crc", "crc_table")], [
                 f"{table}  # {self.title()}" if self.title() else table
             ]
-        if crc_in_one_call(*self.parameters_tuple) is not None:
+        if self.in_one_call is not None:
             return [("binascii", "crc_hqx as _crc_hqx")], []
         return super().python_setup(name)
 
+    @property
+    def in_one_call(self) -> str | None:
+        """crc_in_one_call's expression, for a CRC of whole bytes."""
+        return crc_in_one_call(*self.parameters_tuple) if self.whole_bytes else None
+
     def python_call(self, name: str) -> str:
-        return crc_in_one_call(*self.parameters_tuple) or super().python_call(name)
+        return self.in_one_call or super().python_call(name)
 
     def python_calls_function(self) -> bool:
-        return crc_in_one_call(*self.parameters_tuple) is None
+        return self.in_one_call is None
 
     def python_expression(self, name: str, covered: str) -> str | None:
         return None if self.stepped else super().python_expression(name, covered)
@@ -463,14 +571,16 @@ class Crc(Algorithm):
         name = f"{prefix}_{slug}"
         mask = (1 << self.width) - 1
         t = c_uint(self.width)
+        d = self.data_bits
+        byte = "data[i]" if self.whole_bytes else f"(data[i] & 0x{(1 << d) - 1:x}u)"
         if (
             self.refin
         ):  # the register kept in the input's bit order (reflected); finish reflects it where refout differs
             start = _reflect(self.init, self.width)
             poly = _reflect(self.poly, self.width)
             loop = (
-                "        r ^= data[i];\n"
-                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"        r ^= {byte};\n"
+                f"        for (bit = 0; bit < {d}; bit++) {{\n"
                 f"            r = (r & 1u) ? ((r >> 1) ^ 0x{poly:x}u) : (r >> 1);\n"
                 "        }"
             )
@@ -478,8 +588,8 @@ class Crc(Algorithm):
             start = self.init
             top = 1 << (self.width - 1)
             loop = (
-                f"        r ^= (uint32_t)data[i] << {self.width - 8};\n"
-                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"        r ^= (uint32_t){byte} << {self.width - d};\n"
+                f"        for (bit = 0; bit < {d}; bit++) {{\n"
                 f"            r = (r & 0x{top:x}u) ? (((r << 1) ^ 0x{self.poly:x}u) & 0x{mask:x}u)"
                 f" : ((r << 1) & 0x{mask:x}u);\n"
                 "        }"
@@ -494,8 +604,8 @@ class Crc(Algorithm):
         doc = (
             f"/* {title or 'CRC'}: width {self.width}, poly 0x{self.poly:x}, init 0x{self.init:x}, refin "
             f"{str(self.refin).lower()}, refout {str(self.refout).lower()}, xorout 0x{self.xorout:x} (check "
-            f"0x{self.check:x}). Incremental: start with 0x{start:x}, feed pieces, then {steps}. Bitwise: no table, "
-            "no static data. */"
+            f"0x{self.check:x}{'' if self.whole_bytes else f', the low {d} bits of each byte'}). Incremental: start "
+            f"with 0x{start:x}, feed pieces, then {steps}. Bitwise: no table, no static data. */"
         )
         body = f"""{doc}
 {t} {name}({t} acc, const uint8_t *data, size_t n)
@@ -518,7 +628,7 @@ class Crc(Algorithm):
 
     def lua_parameters(self) -> dict[str, Any]:
         return {"name": self.catalogue} | {
-            p: getattr(self, p) for p in ("width", "poly", "init", "refin", "refout", "xorout")
+            p: getattr(self, p) for p in ("width", "poly", "init", "refin", "refout", "xorout", "data_bits")
         }
 
     def describe(self) -> str:
@@ -533,6 +643,7 @@ class Crc(Algorithm):
             ("refout", str(self.refout)),
             ("xorout", f"{self.xorout:#04x}"),
             ("check ('123456789')", f"{self.check:#04x}"),
+            *([] if self.whole_bytes else [("bits of each byte taken in", f"the low {self.data_bits}")]),
         ]
 
     def worked(self, covered: bytes) -> str:
@@ -552,12 +663,13 @@ _LUA = """function(spec, size, data)
   local width = spec.width
   local top, crc_mask = lshift(1, width - 1), width_mask(width)
   local crc = spec.init
+  local bits = spec.data_bits
   for i = 1, #data do
-    local byte = data:byte(i)
+    local byte = band(data:byte(i), width_mask(bits))
     if spec.refin then
-      byte = reflect(byte, 8)
+      byte = reflect(byte, bits)
     end
-    for bit = 7, 0, -1 do
+    for bit = bits - 1, 0, -1 do
       local feedback = band(crc, top) ~= 0
       if band(rshift(byte, bit), 1) == 1 then
         feedback = not feedback

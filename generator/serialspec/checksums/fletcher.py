@@ -62,9 +62,11 @@ class Fletcher(Algorithm):
     )
 
     @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Fletcher:
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Fletcher:
         if size != 2:
             raise ChecksumProblem(("type",), f"a Fletcher checksum is two bytes (CK_A, CK_B): u16, not {type_name}")
+        if bits:
+            raise ChecksumProblem(("encoding",), "a Fletcher checksum's two sums are whole bytes: not 7 bits a byte")
         return cls(int(raw.get("modulus", 256)))
 
     def function(self) -> Callable[[bytes], int]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
-from serialspec.checksums.base import Algorithm, CCode, Import, Report, hex_bytes, hex_value
+from serialspec.checksums.base import Algorithm, CCode, Import, Wrapping, hex_bytes, hex_value
 from serialspec.runtime.values import dataclass
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -33,7 +33,7 @@ def seeded_function(
 
 
 @dataclass(frozen=True)
-class Seeded(Algorithm):
+class Seeded(Wrapping):
     inner: Algorithm
     offset: int  # of the command's code in the covered bytes
     code_size: int
@@ -41,12 +41,8 @@ class Seeded(Algorithm):
     seeds: tuple[tuple[int, int], ...]  # (code, seed byte), by code
 
     name: ClassVar[str] = "seeded"
-    registered = False
+    registered = False  # made around an algorithm by the framing pass
     summary = "an algorithm with a per-command seed byte after the covered bytes"
-
-    @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Seeded:
-        raise NotImplementedError  # made by the spec language's framing pass around an algorithm
 
     @property
     def width(self) -> int:  # type: ignore[override]
@@ -61,16 +57,6 @@ class Seeded(Algorithm):
         return ("serialspec.checksums.seed", "seeded_function"), (
             f"seeded_function({call}, {self.offset}, {self.code_size}, {self.little}, {seeds})"
         )
-
-    def function_imports(self) -> list[Import]:
-        return [self.function_code()[0], *self.inner.function_imports()]
-
-    def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
-        _, lines = super().python_setup(name)
-        return self.function_imports(), lines
-
-    def title(self) -> str:
-        return self.inner.title()
 
     def c_code(self, prefix: str) -> CCode:
         """The inner algorithm's C (its own copy, named with `<prefix>_seeded`), and a function over the whole
@@ -113,9 +99,8 @@ class Seeded(Algorithm):
         return _LUA
 
     def lua_parameters(self) -> dict[str, Any]:
-        inner = self.inner
         return {
-            "inner": {"algorithm": inner.name, **inner.lua_parameters()} if inner.lua_function() else None,
+            "inner": self.inner_lua(),
             "offset": self.offset,
             "code_size": self.code_size,
             "little": self.little,

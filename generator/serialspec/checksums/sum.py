@@ -113,7 +113,7 @@ class Sum(Algorithm):
     )
 
     @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Sum:
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Sum:
         problem = finish_problem(raw, size * 8)
         if problem is not None:
             raise problem

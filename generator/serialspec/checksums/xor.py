@@ -79,7 +79,7 @@ class Xor(Algorithm):
     )
 
     @classmethod
-    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Xor:
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report, bits: int = 0) -> Xor:
         problem = finish_problem({**raw, "negate": False}, size * 8)
         if problem is not None:
             raise problem

@@ -15,6 +15,7 @@ from typing import Any, assert_never
 
 from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
+from serialspec.checksums.crc import KANGAROO_CRC14
 from serialspec.encodings import bit_run, seven_bit
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
@@ -1113,8 +1114,11 @@ FRAME_ELEMENT = Obj(
             ),
         ),
         "type": Str(
-            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q).",
-            choices=(*SCALAR_TYPES, "u24"),
+            "Wire type of a value, length or checksum (default u8); u24 for a checksum only (RTCM 3's CRC-24Q); u4 "
+            "for an address, command, status or value sent as ONE hex digit inside a hex_ascii span, before the "
+            "content (Victron VE.Direct HEX: `:`, the command as one digit, then bytes as pairs: `command: {role: "
+            "command, type: u4}`); a checksum takes it in as a byte 0..15.",
+            choices=(*SCALAR_TYPES, "u24", "u4"),
         ),
         "endian": Str(
             "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
@@ -1231,6 +1235,15 @@ FRAME_ELEMENT = Obj(
             "dissector verifies it with the last request before it in the capture, and says when that is missing.",
             example=["address", "command"],
         ),
+        "encoding": Str(
+            "checksum: `seven_bit`, its value sent 7 bits a byte, bit 7 of each clear, in the element's byte order "
+            "(Dimension Engineering's Kangaroo: a CRC-14 as two 7-bit bytes, low first, `type: u16, encoding: "
+            "seven_bit` with `crc: {width: 14, ...}`); the element keeps the value's low 7 bits a byte (a CRC's "
+            "width must be those: 14 for a u16), and a frame with bit 7 set in one of its bytes fails the checksum.",
+            choices=("plain", seven_bit.NAME),
+            default="plain",
+            example=seven_bit.NAME,
+        ),
         "size": Int("optional: its size in bytes.", example=13),
         "present_if": Str(
             "optional: when the element is in the frame, as `<element> & <mask>`: it is there when any bit of "
@@ -1258,6 +1271,23 @@ FRAME_ELEMENT = Obj(
     required=("role",),
     description="One element of the frame, in wire order.",
     variants=(
+        (
+            "A CRC over the low 7 bits of each byte, sent 7 bits a byte (Dimension Engineering's Kangaroo: address "
+            "128..135, command, length, data, then a CRC-14 as two 7-bit bytes, low first)",
+            {
+                "crc": {
+                    "role": "checksum",
+                    "type": "u16",
+                    "encoding": "seven_bit",
+                    "algorithm": "crc",
+                    "crc": KANGAROO_CRC14,
+                    "covers": ["address", "content"],
+                }
+            },
+            "`80 20 02 31 00 22 44` (start channel '1') checks: the CRC of the low 7 bits of 80 20 02 31 00 is 0x2222, "
+            "sent as 22 44. A library's reflected polynomial (Kangaroo's 0x22F0) is `poly` reflected over the width "
+            "(0x03D1); the check value is of '123456789', whose bytes are 7-bit already.",
+        ),
         (
             "Error replies told by their status (SHDLC's state byte: an execution error code in bits 6..0, the "
             "device's error flag in bit 7)",

@@ -282,10 +282,15 @@ class _Converter:
         if isinstance(node, yaml.MappingNode):
             self.open.add(id(node))
             result: dict[Any, Any] = {}
-            merged: dict[Any, Any] = {}  # the keys of `<<: *anchor` (or a list of them), which keys given here override
+            # the keys of `<<: *anchor` (or a list of them) stand where `<<` stands (fields and frame elements are in
+            # wire order); a key given here that they hold too overrides its value in their place
+            merged: set[Any] = set()
             for key_node, value_node in node.value:
                 if key_node.tag == _MERGE:
-                    merged = {**self._merge(value_node, path), **merged}
+                    for key, value in self._merge(value_node, path).items():
+                        if key not in result:
+                            result[key] = value
+                            merged.add(key)
                     continue
                 if key_node.__class__ is _ScalarNode and key_node.tag == _STR:
                     key = key_node.value  # a name: most keys
@@ -304,7 +309,9 @@ class _Converter:
                         self.fail(key_node, path, message)
                         continue
                 inner = (*path, key)
-                if key in result:
+                if key in merged:
+                    merged.discard(key)  # given here: it overrides the merged value, in its place
+                elif key in result:
                     self.fail(key_node, inner, f"duplicate key {key!r}")
                     continue
                 if isinstance(key, str) and not key.isprintable() and (bad := CONTROL.search(key)):
@@ -320,7 +327,7 @@ class _Converter:
                 else:
                     result[key] = self._convert(value_node, inner)
             self.open.discard(id(node))
-            return {**merged, **result} if merged else result
+            return result
         if isinstance(node, yaml.SequenceNode):
             self.open.add(id(node))
             items = []

@@ -197,6 +197,11 @@ def reference_markdown(specs: Sequence[Any] = ()) -> str:
         "a field's name). Examples come from the shipped specs and the tutorial's `tinylamp.yaml`. New to "
         "serialspec? Start with the [tutorial](tutorial.md).",
         "",
+        "The order of keys is meaningful where it is the wire's (fields, frame elements). YAML anchors and merge "
+        "keys share definitions: `fields: {data: u32, <<: *telegram}` puts `data` first and the anchored "
+        "`telegram` fields after it, where `<<` stands; a key given beside a merge that it holds too overrides the "
+        "merged value in the merged key's place (`{<<: *station, message_number: {type: u12, const: 1006}}`).",
+        "",
         "Contents: " + ", ".join(_contents(where)),
         "",
     ]

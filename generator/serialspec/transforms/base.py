@@ -142,6 +142,11 @@ class Transform:
 
     # -- the runtime -------------------------------------------------------------------------------------------
 
+    def with_digits(self, offsets: tuple[int, ...]) -> Transform | str:
+        """This transform sending the plain bytes at `offsets` (from the span's start, before the content) as one
+        hex digit each (`type: u4` elements, 0..15), or why it cannot ("" never)."""
+        return f"a u4 element is one hex digit: its span's method must be hex_ascii, not {self.name}"
+
     def runtime(self, span: tuple[int, int]) -> SpanTransform:
         raise NotImplementedError
 

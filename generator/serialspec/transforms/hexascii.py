@@ -5,6 +5,10 @@ As with every transform, a length or checksum inside the span sees the plain byt
 Modbus LRC is the sum of the binary bytes, not of their hex digits); the span's end is where its hex digits end,
 so the element after it must be a trailer that does not start with a hex digit (lang/passes/framing.py asks
 `check_layout`).
+
+Elements of `type: u4` in the span (before the content) are ONE hex digit each (Victron VE.Direct HEX: `:`, the
+command as one digit, then the bytes as pairs): in the plain bytes each is a byte 0..15 (a checksum takes it in so),
+at an offset from the span's start that the spec fixes (`digits`).
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import re
 from collections.abc import Mapping
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.runtime.values import dataclass
+from serialspec.runtime.values import dataclass, replace
 from serialspec.transforms.base import CTransform, Report, Sample, Transform
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -26,11 +30,16 @@ _NOT_HEX = bytes(byte for byte in range(256) if byte not in _HEX)  # bytes.trans
 _RUN = re.compile(b"[0-9A-Fa-f]*")
 
 
-def hex_decode(data: bytes) -> bytes:
-    """Pairs of hex digits (either case) -> bytes; DecodeError in one line naming what is wrong and where."""
+def _hex_digits(data: bytes) -> None:
+    """DecodeError naming the first byte of `data` that is not a hex digit."""
     if len(data.translate(None, _NOT_HEX)) != len(data):
         bad = next(i for i, byte in enumerate(data) if byte not in _HEX)
         raise DecodeError(f"hex-ASCII: byte {data[bad]:02X} at {bad} is not a hex digit")
+
+
+def hex_decode(data: bytes) -> bytes:
+    """Pairs of hex digits (either case) -> bytes; DecodeError in one line naming what is wrong and where."""
+    _hex_digits(data)
     if len(data) % 2:
         raise DecodeError(f"hex-ASCII: {len(data)} hex digits, not whole bytes (an odd count)")
     return bytes.fromhex(data.decode("ascii"))
@@ -43,28 +52,58 @@ def hex_run(buffer: bytes, start: int, end: int) -> int:
     return found.end()
 
 
+def digits_decode(data: bytes, digits: tuple[int, ...]) -> bytes:
+    """Hex digits (either case) -> bytes, the plain bytes at `digits` (offsets) one digit each, the others two;
+    DecodeError in one line naming what is wrong and where."""
+    if not digits:
+        return hex_decode(data)
+    _hex_digits(data)
+    out, position = bytearray(), 0
+    while position < len(data):
+        width = 1 if len(out) in digits else 2
+        if position + width > len(data):
+            raise DecodeError(f"hex-ASCII: {len(data)} hex digits, not whole bytes (a byte cut short)")
+        out.append(int(data[position : position + width], 16))
+        position += width
+    return bytes(out)
+
+
 @dataclass(frozen=True)
 class HexAscii:
-    """Each plain byte of the span as two hex digits: the runtime object of `method: hex_ascii`."""
+    """Each plain byte of the span as two hex digits, those at `digits` (offsets from the span's start) as one: the
+    runtime object of `method: hex_ascii`."""
 
     span: tuple[int, int]
+    digits: tuple[int, ...] = ()
 
     def encode(self, data: bytes) -> bytes:
-        return data.hex().upper().encode("ascii")
+        if not self.digits:
+            return data.hex().upper().encode("ascii")
+        for offset in self.digits:  # the element's range (0..15) was checked before a byte was made
+            if offset < len(data) and data[offset] > 0x0F:
+                raise ValueError(f"hex-ASCII: byte {offset} is {data[offset]:#04x}, not one hex digit")
+        return "".join(f"{byte:X}" if i in self.digits else f"{byte:02X}" for i, byte in enumerate(data)).encode(
+            "ascii"
+        )
 
     def decode(self, data: bytes) -> bytes:
         """The plain bytes; DecodeError names the first byte that is not a hex digit, or an odd count."""
-        return hex_decode(data)
+        return digits_decode(data, self.digits)
+
+    def wire_size(self, count: int) -> int:
+        """The hex digits of the first `count` plain bytes."""
+        return 2 * count - sum(1 for offset in self.digits if offset < count)
 
     def plain_prefix(self, buffer: bytes, start: int, end: int, count: int) -> tuple[bytes, int] | None:
         """The first `count` plain bytes of the hex digits at buffer[start:end] (fewer where the digits end before
         them: the span ends there); None while more digits may come; DecodeError for a span ending mid-byte."""
-        stop = hex_run(buffer, start, min(end, start + 2 * count))
-        if stop == end and stop < start + 2 * count:
+        wire = self.wire_size(count)
+        stop = hex_run(buffer, start, min(end, start + wire))
+        if stop == end and stop < start + wire:
             return None
-        if (stop - start) % 2:
+        if not self.digits and (stop - start) % 2:
             raise DecodeError(f"hex-ASCII: {stop - start} hex digits, not whole bytes (an odd count)")
-        return bytes.fromhex(buffer[start:stop].decode("ascii")), stop - start
+        return digits_decode(buffer[start:stop], self.digits), stop - start
 
     def span_end(self, buffer: bytes, start: int, end: int) -> int | None:
         """Where the span that starts at `start` ends on the wire (its first byte that is no hex digit), None while
@@ -75,6 +114,8 @@ class HexAscii:
 
 @dataclass(frozen=True)
 class HexAsciiTransform(Transform):
+    digits: tuple[int, ...] = ()  # plain offsets from the span's start sent as one digit (`type: u4` elements)
+
     name = "hex_ascii"
     summary = (
         "hex-ASCII (Modbus ASCII): each byte as two hex digits, upper case (decoders take either case); the span "
@@ -103,6 +144,27 @@ class HexAsciiTransform(Transform):
             },
             plain=bytes.fromhex("01 03 00 00 00 01 FB"),
         ),
+        Sample(
+            "VE.Direct HEX: ':', the command as ONE hex digit (a u4 element), the bytes as pairs, a checksum, LF",
+            {
+                "elements": {
+                    "start": {"role": "header", "value": "3A"},
+                    "code": {"role": "command", "type": "u4"},
+                    "content": {"role": "content"},
+                    "check": {
+                        "role": "checksum",
+                        "type": "u8",
+                        "algorithm": "sum",
+                        "init": 0xAB,
+                        "negate": True,
+                        "covers": ["code", "content"],
+                    },
+                    "end": {"role": "trailer", "value": "0A"},
+                },
+                "transparency": {"method": "hex_ascii", "span": ["code", "check"]},
+            },
+            plain=bytes.fromhex("07 00 10 00 3E"),
+        ),
     )
 
     @classmethod
@@ -115,16 +177,21 @@ class HexAsciiTransform(Transform):
             return "hex-ASCII needs a trailer right after its span that does not start with a hex digit (CR LF)"
         return ""
 
+    def with_digits(self, offsets: tuple[int, ...]) -> HexAsciiTransform | str:
+        return replace(self, digits=offsets)
+
     def runtime(self, span: tuple[int, int]) -> HexAscii:
-        return HexAscii(span)
+        return HexAscii(span, self.digits)
 
     def python_arguments(self, span: tuple[int, int]) -> list[str]:
-        return [f"({span[0]}, {span[1]})"]
+        return [f"({span[0]}, {span[1]})", *([repr(self.digits)] if self.digits else [])]
 
     def describe(self) -> str:
+        ones = ", ".join(str(offset) for offset in self.digits)
+        single = f" (the span's byte {ones}, a u4 element, as one digit)" if self.digits else ""
         return (
-            "each byte is sent as two hex digits, upper case (a receiver takes lower case too); a length or checksum "
-            "inside the span is computed over the plain bytes, before they are written as hex"
+            f"each byte is sent as two hex digits{single}, upper case (a receiver takes lower case too); a length or "
+            "checksum inside the span is computed over the plain bytes, before they are written as hex"
         )
 
     def worked(self, plain: bytes) -> str:
@@ -133,10 +200,17 @@ class HexAsciiTransform(Transform):
 
     def c_code(self, prefix: str) -> CTransform:
         name = f"{prefix}__hex_ascii"
-        return CTransform(name, _C_HEX.replace("NAME", name), f"{name}_end", _C_HEX_END.replace("NAME", name))
+        code = _C_HEX
+        if self.digits:  # the bytes at `digits` one digit each: to the wire and back, byte by byte
+            test = " || ".join(f"k == {offset}u" for offset in self.digits)
+            code = code.replace("TO_WIRE", _C_DIGITS_TO_WIRE).replace("FROM_WIRE", _C_DIGITS_FROM_WIRE)
+            code = code.replace("ONE_DIGIT", f"({test})")
+        if not self.digits:
+            code = code.replace("TO_WIRE", _C_PAIRS_TO_WIRE).replace("FROM_WIRE", _C_PAIRS_FROM_WIRE)
+        return CTransform(name, code.replace("NAME", name), f"{name}_end", _C_HEX_END.replace("NAME", name))
 
     def lua(self) -> dict[str, Any] | None:
-        return {"method": "hex_ascii"}
+        return {"method": "hex_ascii", **({"digits": {offset: True for offset in self.digits}} if self.digits else {})}
 
 
 _C_HEX = r"""/* The value of a hex digit of either case; 16 for a byte that is none. */
@@ -164,7 +238,12 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
         *out = cap;
         return 1;
     }
-    if (to_wire) {
+TO_WIRE
+FROM_WIRE
+}
+"""
+
+_C_PAIRS_TO_WIRE = r"""    if (to_wire) {
         if (n > cap / 2u) {
             return 0;
         }
@@ -175,8 +254,8 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
         }
         *out = 2u * n;
         return 1;
-    }
-    if (n % 2u != 0u || n / 2u > cap) {
+    }"""
+_C_PAIRS_FROM_WIRE = r"""    if (n % 2u != 0u || n / 2u > cap) {
         return 0;
     }
     for (i = 0u; i < n; i += 2u) {
@@ -187,9 +266,49 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
         dst[i / 2u] = (uint8_t)((high << 4) | low);
     }
     *out = n / 2u;
-    return 1;
-}
-"""
+    return 1;"""
+# with `digits`: the plain bytes at those offsets (ONE_DIGIT of k) one hex digit each
+_C_DIGITS_TO_WIRE = r"""    if (to_wire) {
+        size_t k, w = 0u;
+        for (k = 0u; k < n; k++) {
+            uint8_t high = (uint8_t)(src[k] >> 4), low = (uint8_t)(src[k] & 0x0Fu);
+            if (ONE_DIGIT) {
+                if (high != 0u || w + 1u > cap) {
+                    return 0;
+                }
+            } else {
+                if (w + 2u > cap) {
+                    return 0;
+                }
+                dst[w++] = (uint8_t)(high < 10u ? 0x30u + high : 0x37u + high);
+            }
+            dst[w++] = (uint8_t)(low < 10u ? 0x30u + low : 0x37u + low);
+        }
+        *out = w;
+        return 1;
+    }"""
+_C_DIGITS_FROM_WIRE = r"""    {
+        size_t k = 0u;
+        for (i = 0u; i < n; k++) {
+            uint8_t high = 0u, low;
+            if (k >= cap) {
+                return 0;
+            }
+            if (!(ONE_DIGIT)) {
+                high = NAME_value(src[i++]);
+                if (i >= n) {
+                    return 0;
+                }
+            }
+            low = NAME_value(src[i++]);
+            if (high > 15u || low > 15u) {
+                return 0;
+            }
+            dst[k] = (uint8_t)((high << 4) | low);
+        }
+        *out = k;
+        return 1;
+    }"""
 
 _C_HEX_END = r"""/* Where the hex digits that start at b[start] end (the first byte that is no hex digit), -2 while
  * b[0..avail) ends inside them (runtime HexAscii.span_end). */

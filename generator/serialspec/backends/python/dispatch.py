@@ -165,6 +165,9 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
     found = DirectionDispatch()
     by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
     codes: dict[str, int | None] = {}  # each key's code (None: frames without one)
+    # each key's messages whose size rules may size its frames: a command's, or its sub-commands' in the direction
+    # (the sensor queries of iRobot's OI: 8E and a packet id, sub-commands by that id, all two bytes)
+    sizers: dict[str, list[Message]] = {}
     for command in protocol.commands:
         entry = direction_entry(command, direction, protocol.byte_order)
         if entry is None:
@@ -179,6 +182,10 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         key = code_key(command, own)
         by_code.setdefault(key, []).append((message, target, low, high))
         codes[key] = command.wire_code(direction) if own.has_command else None
+        if sub_dispatch:
+            sizers.setdefault(key, []).extend(m for m in command.messages() if m.direction == direction)
+        elif message is not None:
+            sizers.setdefault(key, []).append(message)
     for key, users in by_code.items():
         # the resolver allows several only for plain replies, one of them marked default, and for requests told
         # apart by their content size
@@ -199,7 +206,11 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         if len(users) == 1 and users[0][0] is not None:
             found.single[key] = users[0][0]
         messages = [m for m, _, _, _ in users if m is not None]
-        sizing = (sizing_message(messages) or sizing_lead(messages)) if len(messages) == len(users) else None
+        if len(messages) == len(users):
+            sizing = sizing_message(messages) or sizing_lead(messages)
+        else:  # sub-commands: sized where they are all of one fixed size
+            subs = sizers.get(key, [])
+            sizing = sizing_message(subs) if len(subs) > 1 and all(m.subcommand is not None for m in subs) else None
         if sizing is not None:
             found.sized[key] = sizing
         if direction == Direction.RESPONSE and not by_size:

@@ -290,6 +290,15 @@ def _checksum(checksum: Checksum) -> dict[str, Any]:
     return {"algorithm": algorithm.name} | algorithm.lua_parameters()
 
 
+def _wrapped(algorithm: Any) -> list[Any]:
+    """The algorithm and those it wraps (a seed around a 7-bit encoding around a CRC): each has its Lua function."""
+    found = []
+    while algorithm is not None:
+        found.append(algorithm)
+        algorithm = getattr(algorithm, "inner", None)
+    return found
+
+
 def _checksum_functions(protocol: Protocol) -> list[tuple[str, str]]:
     """(algorithm name as a Lua string, its Lua function) of each algorithm the frames use that has one."""
     found = {
@@ -297,8 +306,8 @@ def _checksum_functions(protocol: Protocol) -> list[tuple[str, str]]:
         for layouts in protocol.framing.alternatives.values()
         for layout in layouts
         for checksum in layout.checksums
-        for algorithm in (checksum.algorithm, getattr(checksum.algorithm, "inner", None))
-        if algorithm is not None and (code := algorithm.lua_function()) is not None
+        for algorithm in _wrapped(checksum.algorithm)
+        if (code := algorithm.lua_function()) is not None
     }
     return [(_lua_name(name), code) for name, code in sorted(found.items())]
 

@@ -58,6 +58,7 @@ class FrameElement:
     # shown; `wire` holds each command's (code, code sent), computed when the commands are read
     code: str = ""
     wire: tuple[tuple[int, int], ...] = ()
+    digit: bool = False  # `type: u4`: one hex digit of a hex-ASCII span (a byte 0..15 in the plain bytes)
 
     @property
     def fixed(self) -> bool:

@@ -12,11 +12,14 @@ from typing import Any, Literal
 from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
 from serialspec.checksums.seed import Seeded
+from serialspec.checksums.seven_bit import SevenBitWire
+from serialspec.encodings import seven_bit
 from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.grammar import FRAME_ELEMENT, Str
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
+    SCALARS,
     VALUE_ROLES,
     Checksum,
     Direction,
@@ -195,15 +198,26 @@ class FramingPass(FieldResolver):
         elif role not in CONSTANT_ROLES and role != "content":
             if item.get("type") == "u24":
                 raise self.fail((*path, "type"), f"u24 is a checksum's type, not a {role}'s")
-            scalar = self.scalar_type(item.get("type", "u8"), (*path, "type"), allow_float=False)
+            digit = item.get("type") == "u4"  # one hex digit of a hex-ASCII span: a byte 0..15 in the plain bytes
+            if digit and role in ("checksum", "length"):
+                raise self.fail(
+                    (*path, "type"), f"u4 is an address's, command's, status's or value's type, not a {role}'s"
+                )
+            scalar = (
+                SCALARS["u8"] if digit else self.scalar_type(item.get("type", "u8"), (*path, "type"), allow_float=False)
+            )
             size = scalar.size
         elif "type" in item:
             self.error((*path, "type"), f"a {role} has no type")
         if role in CONSTANT_ROLES and "value" not in item:
             raise self.fail(path, f"a {role} needs `value`: hex bytes, or a mapping by direction")
         low, high = (scalar.minimum, scalar.maximum) if scalar else (0.0, 0.0)
+        if item.get("type") == "u4" and scalar:
+            low, high = 0.0, 15.0
         if "range" in item and scalar:
             low, high = self.bounds(scalar, False, item["range"], (*path, "range"))
+            if item.get("type") == "u4" and not 0 <= low <= high <= 15:
+                self.error((*path, "range"), f"range [{low:g}, {high:g}] does not fit u4 (0..15)")
         broadcast = item.get("broadcast")
         if broadcast is not None and scalar is not None and not scalar.minimum <= broadcast <= scalar.maximum:
             self.error((*path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
@@ -238,6 +252,7 @@ class FramingPass(FieldResolver):
             ("ok", "status"),
             ("truncate", "content"),
             ("from_request", "checksum"),
+            ("encoding", "checksum"),
             ("size", "optional"),
             ("present_if", "optional"),
             ("code", "command"),
@@ -265,6 +280,7 @@ class FramingPass(FieldResolver):
             adds=int(item.get("adds", 0)),
             checksum=checksum,
             code=" ".join(str(item.get("code", "")).split()),
+            digit=item.get("type") == "u4",
         )
 
     def checksum(
@@ -272,13 +288,52 @@ class FramingPass(FieldResolver):
     ) -> Checksum:
         if not item.get("covers"):
             raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
+        seven = item.get("encoding") == seven_bit.NAME  # the value sent 7 bits a byte (Kangaroo's CRC-14)
+        bits = 7 * scalar.size if seven else 0
         try:
             algorithm = checksums.from_spec(
-                item, scalar.size, scalar.name, lambda keys, message: self.error((*path, *keys), message)
+                item, scalar.size, scalar.name, lambda keys, message: self.error((*path, *keys), message), bits
             )
         except ChecksumProblem as problem:
             raise self.fail((*path, *problem.keys), problem.message) from None
+        if seven:
+            algorithm = SevenBitWire(algorithm, scalar.size)
         return Checksum(algorithm, "", "", scalar, endian, name)
+
+    def digits(
+        self,
+        elements: list[FrameElement],
+        digits: list[int],
+        transparency: Transparency | None,
+        t_first: int,
+        elements_path: Path,
+        framing_path: Path,
+    ) -> Transparency:
+        """The transparency whose transform sends the `u4` elements (indexes `digits`) as one digit each: they lie in
+        its span before the content, after elements of fixed size (their plain offsets are then known)."""
+        name = elements[digits[0]].name
+        if transparency is None:
+            raise self.fail(
+                (*elements_path, name, "type"), "u4 is one hex digit: the element must lie in a hex_ascii span"
+            )
+        content = next((i for i, e in enumerate(elements) if e.role == "content"), len(elements))
+        offsets = []
+        for index in digits:
+            if not t_first <= index < content:
+                raise self.fail(
+                    (*elements_path, elements[index].name, "type"),
+                    "a u4 element (one hex digit) lies in the transparency span, before the content",
+                )
+            offsets.append(sum(e.size or 0 for e in elements[t_first:index]))
+        t_last = next(i for i, e in enumerate(elements) if e.name == transparency.last)
+        if any(e.role == "length" for e in elements[t_first : t_last + 1]):
+            raise self.fail(
+                (*elements_path, name, "type"), "a u4 element (one hex digit) and a length in one span: not supported"
+            )
+        taken = transparency.transform.with_digits(tuple(offsets))
+        if isinstance(taken, str):
+            raise self.fail((*framing_path, "transparency"), taken)
+        return replace(transparency, transform=taken)
 
     def seeded(self, checksum: Checksum, elements: list[FrameElement], a: int, b: int, path: Path) -> Checksum:
         """A checksum with `seed: per_command`: its algorithm wrapped with each command's `checksum_seed`, found
@@ -395,6 +450,9 @@ class FramingPass(FieldResolver):
         t_first, t_last = (
             (names.index(transparency.first), names.index(transparency.last)) if transparency else (-1, -1)
         )
+        digits = [i for i, e in enumerate(elements) if e.digit]
+        if digits:
+            transparency = self.digits(elements, digits, transparency, t_first, elements_path, framing_path)
 
         def overlaps_badly(a: int, b: int) -> bool:
             inside = t_first <= a and b <= t_last
@@ -584,6 +642,8 @@ class FramingPass(FieldResolver):
             and (final.size == 1 or final.endian == "<")
             and names.index(checksums[0].first) <= content_index <= names.index(checksums[0].last)
             and all((e.size or 0) <= 1 or e.endian == "<" for e in elements)
+            # the classic stream format keys frames by a one-byte code (SBP's u16 message type: the frame engine)
+            and all(e.size == 1 for e in elements if e.role == "command")
             # constant bit fields in a value (a sync nibble): the general engine checks them (Element.need)
             and not any(fixed_bits(e.bits)[0] for e in elements)
         )

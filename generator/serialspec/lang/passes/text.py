@@ -137,7 +137,12 @@ class TextPass(Pass):
             start, response_start = str(given.get("request") or ""), str(given.get("response") or "")
             if not start or not response_start or start == response_start:
                 self.error((*path, "start"), "give each direction its own start, two different characters")
-        separator, end = (str(raw.get(k) or "?") for k in ("separator", "end"))
+        # a separator or end missing or not text (said above, or by the grammar): stand-ins that clash with nothing,
+        # so that no second line blames the characters of a value that is not there
+        separator, end = (
+            raw[k] if isinstance(raw.get(k), str) and raw[k] else stand_in
+            for k, stand_in in (("separator", "\x1f"), ("end", "\x1e"))
+        )
         if len(start) > 1 or len(response_start) > 1 or len(separator) != 1:
             self.error(path, "`start` (when given) and `separator` must be one character each")
         checksum_raw = raw.get("checksum")

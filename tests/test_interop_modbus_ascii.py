@@ -119,11 +119,13 @@ def test_pymodbus_mask_write_and_read_write(peer_client: Any) -> None:
 
 
 def test_pymodbus_gets_exceptions(peer_client: Any) -> None:
+    # its own register: under xdist another process may have run the test that wrote 110 (a sim each)
+    assert not peer_client.write_register(111, 78, device_id=1).isError()
     beyond = peer_client.read_holding_registers(9998, count=5, device_id=1)
     assert isinstance(beyond, ExceptionResponse) and beyond.exception_code == 2
     coil = peer_client.read_coils(10000, count=1, device_id=1)
     assert isinstance(coil, ExceptionResponse) and coil.exception_code == 2
-    assert peer_client.read_holding_registers(110, count=1, device_id=1).registers == [77]  # still answering
+    assert peer_client.read_holding_registers(111, count=1, device_id=1).registers == [78]  # still answering
 
 
 # --- our generated client against the same server ---------------------------------------------------------------

@@ -1436,7 +1436,16 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
     """The case's C (tests/test_c_backend.py's driver, with the sanitizers) against the Python codec: random messages
     give the same values and bytes, and a stream of them among garbage in pieces gives the same messages; the C
     compiles without a warning under the shipped specs' flags."""
-    from test_c_backend import FLAGS, GCC, PPC_GCC, QEMU_PPC, Driver, agrees_with_python, stream_agrees_with_python
+    from test_c_backend import (
+        DEFAULT_BUILD,
+        FLAGS,
+        GCC,
+        PPC_GCC,
+        QEMU_PPC,
+        Driver,
+        agrees_with_python,
+        stream_agrees_with_python,
+    )
 
     if GCC is None:
         return
@@ -1449,7 +1458,7 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
     assert strict.returncode == 0 and not strict.stderr, strict.stderr
     checked = subprocess.run([str(check)], capture_output=True, text=True, timeout=60)
     assert checked.returncode == 0 and checked.stdout.endswith(" 0 failed\n"), checked.stdout + checked.stderr
-    builds: list[tuple[tuple[str, ...], str]] = [((), "gcc")]
+    builds: list[tuple[tuple[str, ...], str]] = [((), DEFAULT_BUILD)]
     if PPC_GCC and QEMU_PPC and any(word in name for word in BYTE_ORDER_WORDS):  # values built from bytes and bits
         builds.append(((PPC_GCC, "-static"), "powerpc-be"))
     for command, build_name in builds:

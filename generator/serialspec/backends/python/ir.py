@@ -308,10 +308,8 @@ def single_line(statement: Statement) -> bool:
 
 def raises(statements: Iterable[Statement]) -> bool:
     """Whether any of the statements raises an error (a check, or a helper that checks)."""
-    return any(
-        isinstance(s, Raise | ContentSize | Needs | Expect | LeftOver | ItemsCheck) or (isinstance(s, Code) and s.checks)
-        for s in walk(statements)
-    )
+    checks = Raise | ContentSize | Needs | Expect | LeftOver | ItemsCheck
+    return any(isinstance(s, checks) or (isinstance(s, Code) and s.checks) for s in walk(statements))
 
 
 def reads_cursor(statement: Statement) -> bool:

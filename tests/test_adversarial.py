@@ -182,3 +182,19 @@ def test_spec_outputs_compile(path: Path, tmp_path: Path) -> None:
         options = [f"-Xlua_script:{script}" for script in scripts]
         loaded = subprocess.run([TSHARK, *options, "-r", "/dev/null"], text=True, capture_output=True)
         assert "Lua" not in loaded.stderr, loaded.stderr
+
+
+def test_a_reply_sized_0_by_its_request_is_no_frame() -> None:
+    """A reply sized by its request (`size_from: request.length - 2`) to a request that asks for no bytes: a frame of
+    0 bytes, which the stream parser took at the same place over and over (feed() never returned); the replies of
+    other sizes are taken as before."""
+    path = CORPUS / "specs" / "size_from_a_request_that_asks_for_no_bytes.yaml"
+    lines, files = generated(load_file(str(path), path.name))
+    assert lines == []
+    modules = {name.partition("/")[2]: body for name, body in files.items() if name.startswith("adversarial/")}
+    with imported("adversarial", modules) as package:
+        parser = package.StreamParser("response")
+        parser.expect(package.ProbeResponse, package.ProbeRequest(length=2))
+        assert parser.feed(b"\x01\x02") == []
+        parser.expect(package.ProbeResponse, package.ProbeRequest(length=4))
+        assert parser.feed(b"\x02\x03") == [package.ProbeResponse(data=b"\x02\x03")]

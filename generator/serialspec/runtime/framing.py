@@ -1272,7 +1272,7 @@ class FrameStreamParser(StreamParser):
             size = sizer(buffer, position, end)
             if size is None:
                 found.append((end + 1, None, None))
-            elif size >= 0:
+            elif size > 0:  # (a reply sized 0 by its request: no bytes, no frame in a stream)
                 stop = position + size
                 found.append((stop, decode, verify) if stop <= end else (stop, None, None))
         if len(found) > 1:

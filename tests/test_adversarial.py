@@ -198,3 +198,25 @@ def test_a_reply_sized_0_by_its_request_is_no_frame() -> None:
         assert parser.feed(b"\x01\x02") == []
         parser.expect(package.ProbeResponse, package.ProbeRequest(length=4))
         assert parser.feed(b"\x02\x03") == [package.ProbeResponse(data=b"\x02\x03")]
+
+
+def test_a_frame_beaten_by_one_inside_it_is_undecided_whatever_the_reads() -> None:
+    """RPLIDAR (tests/specs/slamtec_rplidar.yaml): a 27-byte info reply (its layout beside the headerless 5-byte
+    measurements) that decodes, beaten by a measurement inside it that ends first. Fed byte by byte, the info was
+    still waiting when the measurement ended, so the failed candidates after its start were never counted; fed in
+    one read they were (17 errors against 12): the displaced frame is undecided when the one taken ends, whatever
+    the reads."""
+    from serialspec.backends.python.package import emit_package
+    from serialspec.lang.resolve import resolve
+
+    path = Path(__file__).parent / "specs" / "slamtec_rplidar.yaml"
+    protocol = resolve(load_file(str(path), path.name))
+    stream = hex_bytes("a5 5a 14 00 00 00 04 01" + " 00" * 19)
+    with imported(protocol.name, emit_package(protocol)) as package:
+        outcomes = []
+        for reads in ([stream], [bytes([b]) for b in stream], [stream[:9], stream[9:]]):
+            parser = package.StreamParser("response")
+            found = [m for chunk in reads for m in parser.feed(chunk)]
+            outcomes.append(([type(m).__name__ for m in found], parser.errors, parser.garbage, parser.pending()))
+        assert outcomes[0] == (["MeasurementResponse"], 12, 18, b"\x00" * 4)
+        assert outcomes[1:] == outcomes[:1] * 2

@@ -1193,6 +1193,7 @@ class FrameStreamParser(StreamParser):
             best: tuple[Message, int, int] | None = None
             bound = end + 1  # where the best frame so far ends: a frame must end before it to win
             seen: list[tuple[int, int, bool]] = []  # candidates before it: (start, end or end + 1, corrupt)
+            displaced: list[tuple[int, int, bool]] = []  # frames taken for best, then beaten by one ending first
             waiting = False
             position = start
             while True:
@@ -1232,6 +1233,8 @@ class FrameStreamParser(StreamParser):
                         except DecodeError:
                             message = None
                     if message is not None:
+                        if best is not None:  # a frame that completes first, inside the best one so far: that
+                            displaced.append((best[1], best[2], False))  # one is undecided when this one ends
                         best, bound, outcome = (message, position, stop), stop, None
                         break
                     outcome = (stop, True)
@@ -1240,6 +1243,8 @@ class FrameStreamParser(StreamParser):
                 position += 1
             first, last = (best[1], best[2]) if best is not None else (end + 1, end)
             hold = -1
+            if displaced:
+                seen = sorted(seen + displaced)
             for position, stop, corrupt in seen:
                 if position >= first:
                     break

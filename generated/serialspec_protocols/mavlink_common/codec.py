@@ -94,7 +94,8 @@ def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, s
     v_target_system = t[1]
     v_target_component = t[2]
     v_param_id = t[3]
-    return _new(ParamRequestReadRequest, (seq, sysid, compid, v_param_index, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_request_read request'), signature))
+    v_param_id = _unpad_text(v_param_id, 0, 'param_id', 'param_request_read request')
+    return _new(ParamRequestReadRequest, (seq, sysid, compid, v_param_index, v_target_system, v_target_component, v_param_id, signature))
 
 
 def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamValueResponse:
@@ -108,8 +109,9 @@ def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: 
     v_param_count = t[1]
     v_param_index = t[2]
     v_param_id = t[3]
+    v_param_id = _unpad_text(v_param_id, 0, 'param_id', 'param_value response')
     v_param_type = t[4]
-    return _new(ParamValueResponse, (seq, sysid, compid, v_param_value, v_param_count, v_param_index, _unpad_text(v_param_id, 0, 'param_id', 'param_value response'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
+    return _new(ParamValueResponse, (seq, sysid, compid, v_param_value, v_param_count, v_param_index, v_param_id, _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
 def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamSetRequest:
@@ -123,8 +125,9 @@ def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int
     v_target_system = t[1]
     v_target_component = t[2]
     v_param_id = t[3]
+    v_param_id = _unpad_text(v_param_id, 0, 'param_id', 'param_set request')
     v_param_type = t[4]
-    return _new(ParamSetRequest, (seq, sysid, compid, v_param_value, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_set request'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
+    return _new(ParamSetRequest, (seq, sysid, compid, v_param_value, v_target_system, v_target_component, v_param_id, _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
 def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> AttitudeResponse:

@@ -195,17 +195,20 @@ def _decode_mon_ver_response(buf: bytes, o: int, end: int) -> MonVerResponse:
         raise content_size_error('mon_ver response', end - o, 40, None)
     t = _S_B30_B10.unpack_from(buf, o)
     v_sw_version = t[0]
+    v_sw_version = _unpad_text(v_sw_version, 0, 'sw_version', 'mon_ver response')
     v_hw_version = t[1]
+    v_hw_version = _unpad_text(v_hw_version, 0, 'hw_version', 'mon_ver response')
     o += 40
     v_extensions_list = []
     if (end - o) % 30:
         raise DecodeError('mon_ver response' + f': {end - o} bytes do not split into extensions items of 30')
     n = end - o
     for v_extension, in _S_B30.iter_unpack(buf[o : o + n]):
-        item = _new(ExtensionsItem, (_unpad_text(v_extension, 0, 'extension', 'mon_ver response'),))
+        v_extension = _unpad_text(v_extension, 0, 'extension', 'mon_ver response')
+        item = _new(ExtensionsItem, (v_extension,))
         v_extensions_list.append(item)
     v_extensions = tuple(v_extensions_list)
-    return _new(MonVerResponse, (_unpad_text(v_sw_version, 0, 'sw_version', 'mon_ver response'), _unpad_text(v_hw_version, 0, 'hw_version', 'mon_ver response'), v_extensions))
+    return _new(MonVerResponse, (v_sw_version, v_hw_version, v_extensions))
 
 
 def _encode_nav_status_request(m: NavStatusRequest) -> bytes:

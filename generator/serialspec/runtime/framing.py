@@ -1123,7 +1123,7 @@ class FrameStreamParser(StreamParser):
     byte. The rule of runtime/stream.py decides between overlapping candidates, whatever the reads: the frame that
     completes first wins (of two ending on the same byte, the first), so a candidate, complete or still waiting for
     bytes, never hides a valid frame that starts inside it and ends before it. Where several layouts fit at one
-    position, the one that completes first decides it.
+    position, the one that completes first and decodes is its frame (one that fails leaves the next its chance).
     """
 
     def __init__(self, *formats: tuple[FrameCodec, Decode]) -> None:
@@ -1193,6 +1193,7 @@ class FrameStreamParser(StreamParser):
             best: tuple[Message, int, int] | None = None
             bound = end + 1  # where the best frame so far ends: a frame must end before it to win
             seen: list[tuple[int, int, bool]] = []  # candidates before it: (start, end or end + 1, corrupt)
+            displaced: list[tuple[int, int, bool]] = []  # frames taken for best, then beaten by one ending first
             waiting = False
             position = start
             while True:
@@ -1207,34 +1208,43 @@ class FrameStreamParser(StreamParser):
                 # candidate is known to be waiting for more)
                 if position >= end or (position + smallest >= bound and (best is not None or waiting)):
                     break
-                sized = self._size(buffer, position, end)
-                if sized is not None:
-                    stop, decode, verify = sized
+                # the layouts that fit here, the one that completes first first: the first of them that decodes is
+                # the candidate's frame; one that fails leaves the next its chance (RPLIDAR: a 5-byte measurement
+                # that fails before the 7-byte scan descriptor at the same place)
+                outcome: tuple[int, bool] | None = None  # where the candidate is decided (end + 1: waiting), corrupt
+                for stop, decode, verify in self._sizes(buffer, position, end):
                     if decode is None:  # still waiting for bytes
-                        seen.append((position, end + 1, False))
+                        outcome = (end + 1, False)
                         waiting = True
-                    elif stop < bound:
-                        message = None
-                        # the checksum first (no message built when it fails), but for the candidate the scan
-                        # starts at, usually a frame: decoding it checks the checksum once
-                        if verify is None or position == start or verify(buffer, position, stop):
-                            try:
-                                message = (
-                                    decode(buffer[position:stop], expected)
-                                    if request is None
-                                    else decode(buffer[position:stop], expected, request)
-                                )
-                            except DecodeError:
-                                message = None
-                        if message is None:
-                            seen.append((position, stop, True))
-                        else:
-                            best, bound = (message, position, stop), stop
-                    else:
-                        seen.append((position, stop, False))
+                        break
+                    if stop >= bound:
+                        outcome = (stop, False)
+                        break
+                    message = None
+                    # the checksum first (no message built when it fails), but for the candidate the scan
+                    # starts at, usually a frame: decoding it checks the checksum once
+                    if verify is None or position == start or verify(buffer, position, stop):
+                        try:
+                            message = (
+                                decode(buffer[position:stop], expected)
+                                if request is None
+                                else decode(buffer[position:stop], expected, request)
+                            )
+                        except DecodeError:
+                            message = None
+                    if message is not None:
+                        if best is not None:  # a frame that completes first, inside the best one so far: that
+                            displaced.append((best[1], best[2], False))  # one is undecided when this one ends
+                        best, bound, outcome = (message, position, stop), stop, None
+                        break
+                    outcome = (stop, True)
+                if outcome is not None:
+                    seen.append((position, *outcome))
                 position += 1
             first, last = (best[1], best[2]) if best is not None else (end + 1, end)
             hold = -1
+            if displaced:
+                seen = sorted(seen + displaced)
             for position, stop, corrupt in seen:
                 if position >= first:
                     break
@@ -1258,19 +1268,21 @@ class FrameStreamParser(StreamParser):
         self._pending = buffer[cut:]
         return found
 
-    def _size(self, buffer: bytes, position: int, end: int) -> tuple[int, Decode | None, Verify | None] | None:
-        """The candidate at `position`: (where its layout that completes first ends, that layout's decoder and
-        checksum test), the decoder None while it must wait for bytes (its size is not known yet, or it ends past
-        `end`); None when no layout fits."""
-        best: tuple[int, Decode | None, Verify | None] | None = None
+    def _sizes(self, buffer: bytes, position: int, end: int) -> list[tuple[int, Decode | None, Verify | None]]:
+        """The layouts that fit the candidate at `position`, the one that completes first first (of two ending
+        together, the first layout): (where it ends, its decoder and checksum test), the decoder None while it must
+        wait for bytes (its size not known yet: it ends past `end` anyway; or it ends past `end`)."""
+        found: list[tuple[int, Decode | None, Verify | None]] = []
         for sizer, decode, verify in self._sizers_by_first[buffer[position]]:
             size = sizer(buffer, position, end)
             if size is None:
-                if best is None:
-                    best = (end + 1, None, None)
-            elif size >= 0 and (best is None or position + size < best[0]):
-                best = (position + size, decode, verify) if position + size <= end else (position + size, None, None)
-        return best
+                found.append((end + 1, None, None))
+            elif size > 0:  # (a reply sized 0 by its request: no bytes, no frame in a stream)
+                stop = position + size
+                found.append((stop, decode, verify) if stop <= end else (stop, None, None))
+        if len(found) > 1:
+            found.sort(key=lambda sized: sized[0])
+        return found
 
     def gap(self) -> None:
         """The line went idle: the bytes held are dropped as garbage (StreamParser.gap)."""

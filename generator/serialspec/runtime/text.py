@@ -972,6 +972,10 @@ class TextStreamParser:
                     self._buffer = self._buffer[len(self._start) :]
                     continue
                 return found
+            if end + len(self._end) - 1 > limit:  # it grew past max_length before its ending came: read in pieces,
+                self._dropped(f"no line ending within {self.framing.max_length} characters")  # it is dropped too
+                self._buffer = self._buffer[len(self._start) :]
+                continue
             frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
             try:
                 found.append(self._decoded(frame))
@@ -999,6 +1003,9 @@ class TextStreamParser:
             frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
             if self._overlong:  # the rest of a line already dropped
                 self._overlong = False
+                continue
+            if end + len(self._end) - 1 > limit:  # it grew past max_length before its ending came (whatever the reads)
+                self._dropped(f"no line ending within {self.framing.max_length} characters")
                 continue
             if not frame[:end].strip():
                 continue

@@ -664,9 +664,11 @@ class PackageCode:
         if isinstance(f, Text) and isinstance(f.size, int):  # read as bytes by the run's struct
             if f.pad is not None:
                 self.packing.add("unpad_text")
-                return f"_unpad_text({name}, {f.pad}, {spec_key(f.name)}, {where})"
-            helper = self.text_decoder(f)
-            return f"{helper}({name}, {spec_key(f.name)}, {where})"
+                text = f"_unpad_text({name}, {f.pad}, {spec_key(f.name)}, {where})"
+            else:
+                text = f"{self.text_decoder(f)}({name}, {spec_key(f.name)}, {where})"
+            body.append(Code(f"{name} = {text}", checks=True))  # refuses bytes that are not its text
+            return name
         if not isinstance(f, Scalar):
             return name
         if f.odd_width:  # read as 3 bytes

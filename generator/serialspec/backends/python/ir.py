@@ -20,12 +20,14 @@ from typing import assert_never
 @dataclass(frozen=True)
 class Code:
     """A simple statement no rewrite looks into; `cursor`: it reads `o` or `end`; `reads`: the constant offsets of
-    `buf` it reads."""
+    `buf` it reads; `checks`: it calls a runtime helper that may refuse the value (raises DecodeError: text that is
+    not UTF-8), so a decoder that must raise nothing (the whole-frame decoders) cannot hold it."""
 
     text: str
     cursor: bool = False
     reads: tuple[int, ...] = ()
     lists: tuple[str, ...] = ()  # the lists of numbers whose items it packs (PackItems), by their expressions
+    checks: bool = False
 
     def lines(self) -> list[str]:
         return [self.text]
@@ -305,8 +307,9 @@ def single_line(statement: Statement) -> bool:
 
 
 def raises(statements: Iterable[Statement]) -> bool:
-    """Whether any of the statements raises an error (a check)."""
-    return any(isinstance(s, Raise | ContentSize | Needs | Expect | LeftOver | ItemsCheck) for s in walk(statements))
+    """Whether any of the statements raises an error (a check, or a helper that checks)."""
+    checks = Raise | ContentSize | Needs | Expect | LeftOver | ItemsCheck
+    return any(isinstance(s, checks) or (isinstance(s, Code) and s.checks) for s in walk(statements))
 
 
 def reads_cursor(statement: Statement) -> bool:

@@ -411,3 +411,41 @@ def test_the_simulator_answers_with_its_own_values_not_the_requests(tmp_path: Pa
     assert (reply.sender, reply.kind, reply.autopilot, reply.mode) == (0, 2, 3, 4)
     (reply,) = answers(p, m.SetValueRequest(sender=0, slot=5, value=700))
     assert (reply.slot, reply.value) == (5, 700)
+
+
+ONE_RAW_READ = """\
+framing:
+  elements:
+    command: {role: command, type: u8, directions: [request]}
+    content: {role: content}
+commands:
+  read:
+    code: 1
+    request:
+      fields: {length: u8}
+    response:
+      fields:
+        data: {type: bytes, size: rest, size_from: request.length - 2}
+"""
+
+
+def test_the_one_reply_sized_by_its_request_is_read_with_it(tmp_path: Path) -> None:
+    """A protocol of one command whose reply is raw bytes as many as the request says (no header, code or length):
+    the stream parser took nothing, whatever the request awaited (with a second command it read them), so a client
+    timed out. Its bytes are read with the request, whatever the reads."""
+    package = generated_package(tmp_path, "raw_read", ONE_RAW_READ)
+    request = package.messages.ReadRequest(length=5)
+    reply = package.messages.ReadResponse(data=b"abc")
+    assert package.encode(reply) == b"abc"
+    assert package.decode(b"abc", "response", request=request) == reply
+    for sizes in ([3], [1, 1, 1], [2, 1]):
+        parser = package.StreamParser("response")
+        parser.expect(package.messages.ReadResponse, request)
+        stream, found = b"abc", []
+        for size in sizes:
+            found += parser.feed(stream[:size])
+            stream = stream[size:]
+        assert found == [reply], sizes
+    parser = package.StreamParser("response")
+    parser.expect(package.messages.ReadResponse, package.messages.ReadRequest(length=4))
+    assert parser.feed(b"ab") == [package.messages.ReadResponse(data=b"ab")]

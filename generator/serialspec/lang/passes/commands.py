@@ -855,8 +855,12 @@ def codeless_replies(commands: list[Command], framing: Framing) -> bool:
     if layout.has_command or layout.length is not None or layout.trailer or layout.transparency is not None:
         return False
     replies = [m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE]
-    if len(replies) < 2 or any(m.unsolicited for m in replies) or sizing_lead(replies) is not None:
+    if not replies or any(m.unsolicited for m in replies) or sizing_lead(replies) is not None:
         return False  # (replies picked by a leading constant, each sized by its own bytes, are read alone)
+    if len(replies) == 1:  # the one reply: as long as its request says (`size_from`, `count_from`), or read alone
+        return any(
+            isinstance(f, Bytes) and f.size_from or isinstance(f, List) and f.count_from for f in replies[0].fields
+        )
     return len({(m.min_size, m.max_size) for m in replies}) > 1 or replies[0].min_size != replies[0].max_size
 
 

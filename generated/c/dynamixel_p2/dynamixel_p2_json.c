@@ -5,6 +5,7 @@
 
 #include "dynamixel_p2_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 

@@ -5,6 +5,7 @@
 
 #include "feetech_sms_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 

@@ -5,6 +5,7 @@
 
 #include "hiwonder_rrc_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -57,9 +58,9 @@ static void hiwonder_rrc__wf(hiwonder_rrc__w_t *w, double v)
     char t[40];
     if (!(v >= 0.0 || v < 0.0)) { /* NaN (compared so, not v != v: clean under -Wfloat-equal) */
         hiwonder_rrc__ws(w, "NaN");
-    } else if (v > 1.7976931348623157e308) {
+    } else if (v > DBL_MAX) { /* DBL_MAX, not a constant: double is 32 bits on AVR */
         hiwonder_rrc__ws(w, "Infinity");
-    } else if (v < -1.7976931348623157e308) {
+    } else if (v < -DBL_MAX) {
         hiwonder_rrc__ws(w, "-Infinity");
     } else {
         (void)snprintf(t, sizeof(t), "%.17g", v);

@@ -5,6 +5,7 @@
 
 #include "modbus_ascii_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -65,7 +66,7 @@ static void modbus_ascii__json_read_coils_response(modbus_ascii__w_t *w, const m
     modbus_ascii__ws(w, "[");
     for (i1 = 0u; i1 < m->coils_count; i1++) {
         if (i1) { modbus_ascii__ws(w, ", "); }
-        modbus_ascii__ws(w, ((m->coils[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_ascii__ws(w, (((unsigned)m->coils[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_ascii__ws(w, "]");
 }
@@ -93,7 +94,7 @@ static void modbus_ascii__json_read_discrete_inputs_response(modbus_ascii__w_t *
     modbus_ascii__ws(w, "[");
     for (i1 = 0u; i1 < m->inputs_count; i1++) {
         if (i1) { modbus_ascii__ws(w, ", "); }
-        modbus_ascii__ws(w, ((m->inputs[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_ascii__ws(w, (((unsigned)m->inputs[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_ascii__ws(w, "]");
 }
@@ -215,7 +216,7 @@ static void modbus_ascii__json_write_coils_request(modbus_ascii__w_t *w, const m
     modbus_ascii__ws(w, "[");
     for (i1 = 0u; i1 < m->values_count; i1++) {
         if (i1) { modbus_ascii__ws(w, ", "); }
-        modbus_ascii__ws(w, ((m->values[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_ascii__ws(w, (((unsigned)m->values[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_ascii__ws(w, "]");
 }

@@ -5,6 +5,7 @@
 
 #include "modbus_rtu_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -65,7 +66,7 @@ static void modbus_rtu__json_read_coils_response(modbus_rtu__w_t *w, const modbu
     modbus_rtu__ws(w, "[");
     for (i1 = 0u; i1 < m->coils_count; i1++) {
         if (i1) { modbus_rtu__ws(w, ", "); }
-        modbus_rtu__ws(w, ((m->coils[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_rtu__ws(w, (((unsigned)m->coils[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_rtu__ws(w, "]");
 }
@@ -93,7 +94,7 @@ static void modbus_rtu__json_read_discrete_inputs_response(modbus_rtu__w_t *w, c
     modbus_rtu__ws(w, "[");
     for (i1 = 0u; i1 < m->inputs_count; i1++) {
         if (i1) { modbus_rtu__ws(w, ", "); }
-        modbus_rtu__ws(w, ((m->inputs[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_rtu__ws(w, (((unsigned)m->inputs[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_rtu__ws(w, "]");
 }
@@ -215,7 +216,7 @@ static void modbus_rtu__json_write_coils_request(modbus_rtu__w_t *w, const modbu
     modbus_rtu__ws(w, "[");
     for (i1 = 0u; i1 < m->values_count; i1++) {
         if (i1) { modbus_rtu__ws(w, ", "); }
-        modbus_rtu__ws(w, ((m->values[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
+        modbus_rtu__ws(w, (((unsigned)m->values[i1 / 8u] >> (i1 % 8u)) & 1u) ? "true" : "false");
     }
     modbus_rtu__ws(w, "]");
 }

@@ -5,6 +5,7 @@
 
 #include "vesc_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 

@@ -1551,7 +1551,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(ctx.loop(pad, depth, f"{tgt}_count"))
                 out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
                 if f.item is None:
-                    bit = f"({tgt}[i{depth} / 8u] >> (i{depth} % 8u)) & 1u"
+                    bit = f"((unsigned){tgt}[i{depth} / 8u] >> (i{depth} % 8u)) & 1u"  # unsigned: AVR has a 16-bit int
                     out.append(f'{pad}    {ctx.p}__ws(w, ({bit}) ? "true" : "false");')
                 else:
                     out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))

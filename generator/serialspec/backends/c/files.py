@@ -2618,6 +2618,7 @@ def json_source(ctx: Ctx) -> str:
     text = f"""{banner(protocol)}
 #include "{p}_json.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -2680,9 +2681,9 @@ def json_writers(p: str) -> list[tuple[str, str]]:
     char t[40];
     if (!(v >= 0.0 || v < 0.0)) {{ /* NaN (compared so, not v != v: clean under -Wfloat-equal) */
         {p}__ws(w, "NaN");
-    }} else if (v > 1.7976931348623157e308) {{
+    }} else if (v > DBL_MAX) {{ /* DBL_MAX, not a constant: double is 32 bits on AVR */
         {p}__ws(w, "Infinity");
-    }} else if (v < -1.7976931348623157e308) {{
+    }} else if (v < -DBL_MAX) {{
         {p}__ws(w, "-Infinity");
     }} else {{
         (void)snprintf(t, sizeof(t), "%.17g", v);

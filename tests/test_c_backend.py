@@ -1249,6 +1249,24 @@ def test_example_host_program_talks_to_a_virtual_servo(tmp_path: Path) -> None:
     assert read["command"] == "reply" and len(bytes.fromhex(read["fields"]["data"])) == 6
 
 
+def test_the_avr_example_builds_as_its_comment_says_and_fits_an_arduino_mega(tmp_path: Path) -> None:
+    """examples/c/avr_servo_follow.c (an ATmega2560 on a servo bus: a 16-bit int) built by the avr-gcc command its
+    comment prints, with the strict warnings added: no warning, and its static RAM (.data + .bss) within a quarter of
+    the chip's 8 KiB, as the comment's capacity overrides promise."""
+    if AVR_GCC is None:
+        pytest.skip("avr-gcc missing (apt-get install gcc-avr avr-libc; make generate installs it as root)")
+    comment = (ROOT / "examples/c/avr_servo_follow.c").read_text().split("*/", 1)[0]
+    printed = comment.split(" *   avr-gcc", 1)[1].split("\n *   avr-objcopy", 1)[0]
+    words = ["avr-gcc", *printed.replace("\\\n *", " ").split()]
+    assert words[-2] == "-o"
+    flags = [flag for flag in FLAGS if flag not in AVR_LEAVES_OUT]
+    run = subprocess.run([*words[:-1], str(tmp_path / "follow.elf"), *flags], cwd=ROOT, capture_output=True, text=True)
+    assert run.returncode == 0 and not run.stderr, run.stderr
+    sizes = subprocess.run(["avr-size", "-A", str(tmp_path / "follow.elf")], capture_output=True, text=True).stdout
+    ram = sum(int(line.split()[1]) for line in sizes.splitlines() if line.startswith((".data", ".bss")))
+    assert 0 < ram <= 2048, sizes
+
+
 # gcc with the sanitizers in `make test` (the examples already run on the other builds through the driver: see
 # test_examples_and_a_noisy_stream_give_the_same_on_other_builds); every build in `make c-check`
 VECTOR_BUILDS = BUILDS if C_CHECK else BUILDS[:1]

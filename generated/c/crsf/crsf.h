@@ -140,66 +140,66 @@ typedef enum {
 
 /* GPS (CRSF_FRAMETYPE_GPS) (request).  */
 typedef struct {
-    int32_t latitude;  /* Latitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t longitude;  /* Longitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    uint16_t groundspeed;  /* Ground speed in km/h × 10.; unit: 0.1 km/h; scale: 0.1 per unit; range 0..65535 */
-    uint16_t heading;  /* Course over ground in degrees × 100.; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
-    uint16_t altitude;  /* Altitude in metres + 1000 (0 is -1000 m).; unit: m; offset: -1000; range 0..65535 */
-    uint8_t satellites;  /* Satellites in use.; range 0..255 */
+    int32_t latitude;  /* Latitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t longitude;  /* Longitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    uint16_t groundspeed;  /* Ground speed in km/h × 10; unit: 0.1 km/h; scale: 0.1 per unit; range 0..65535 */
+    uint16_t heading;  /* Course over ground in degrees × 100; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
+    uint16_t altitude;  /* Altitude in metres + 1000 (0 is -1000 m); unit: m; offset: -1000; range 0..65535 */
+    uint8_t satellites;  /* Satellites in use; range 0..255 */
 } crsf_gps_request_t;
 
 /* GPS (CRSF_FRAMETYPE_GPS) (response).  */
 typedef struct {
-    int32_t latitude;  /* Latitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t longitude;  /* Longitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    uint16_t groundspeed;  /* Ground speed in km/h × 10.; unit: 0.1 km/h; scale: 0.1 per unit; range 0..65535 */
-    uint16_t heading;  /* Course over ground in degrees × 100.; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
-    uint16_t altitude;  /* Altitude in metres + 1000 (0 is -1000 m).; unit: m; offset: -1000; range 0..65535 */
-    uint8_t satellites;  /* Satellites in use.; range 0..255 */
+    int32_t latitude;  /* Latitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t longitude;  /* Longitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    uint16_t groundspeed;  /* Ground speed in km/h × 10; unit: 0.1 km/h; scale: 0.1 per unit; range 0..65535 */
+    uint16_t heading;  /* Course over ground in degrees × 100; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
+    uint16_t altitude;  /* Altitude in metres + 1000 (0 is -1000 m); unit: m; offset: -1000; range 0..65535 */
+    uint8_t satellites;  /* Satellites in use; range 0..255 */
 } crsf_gps_response_t;
 
 /* Battery sensor (CRSF_FRAMETYPE_BATTERY_SENSOR) (request).  */
 typedef struct {
-    uint16_t voltage;  /* Voltage in V × 10.; unit: 0.1 V; scale: 0.1 per unit; range 0..65535 */
-    uint16_t current;  /* Current in A × 10.; unit: 0.1 A; scale: 0.1 per unit; range 0..65535 */
-    uint32_t capacity;  /* Charge drawn in mAh.; unit: mAh; range 0..1.67772e+07 */
-    uint8_t remaining;  /* Charge left in percent.; unit: %; range 0..100 */
+    uint16_t voltage;  /* Voltage in V × 10; unit: 0.1 V; scale: 0.1 per unit; range 0..65535 */
+    uint16_t current;  /* Current in A × 10; unit: 0.1 A; scale: 0.1 per unit; range 0..65535 */
+    uint32_t capacity;  /* Charge drawn in mAh; unit: mAh; range 0..1.67772e+07 */
+    uint8_t remaining;  /* Charge left in percent; unit: %; range 0..100 */
 } crsf_battery_request_t;
 
 /* Battery sensor (CRSF_FRAMETYPE_BATTERY_SENSOR) (response).  */
 typedef struct {
-    uint16_t voltage;  /* Voltage in V × 10.; unit: 0.1 V; scale: 0.1 per unit; range 0..65535 */
-    uint16_t current;  /* Current in A × 10.; unit: 0.1 A; scale: 0.1 per unit; range 0..65535 */
-    uint32_t capacity;  /* Charge drawn in mAh.; unit: mAh; range 0..1.67772e+07 */
-    uint8_t remaining;  /* Charge left in percent.; unit: %; range 0..100 */
+    uint16_t voltage;  /* Voltage in V × 10; unit: 0.1 V; scale: 0.1 per unit; range 0..65535 */
+    uint16_t current;  /* Current in A × 10; unit: 0.1 A; scale: 0.1 per unit; range 0..65535 */
+    uint32_t capacity;  /* Charge drawn in mAh; unit: mAh; range 0..1.67772e+07 */
+    uint8_t remaining;  /* Charge left in percent; unit: %; range 0..100 */
 } crsf_battery_response_t;
 
 /* Link statistics (CRSF_FRAMETYPE_LINK_STATISTICS) (request).  */
 typedef struct {
-    uint8_t uplink_rssi_ant1;  /* Uplink RSSI, antenna 1 (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t uplink_rssi_ant2;  /* Uplink RSSI, antenna 2 (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t uplink_link_quality;  /* Uplink packet success rate.; unit: %; range 0..100 */
-    int8_t uplink_snr;  /* Uplink signal-to-noise ratio.; unit: dB; range -128..127 */
-    uint8_t active_antenna;  /* The receiver's antenna in use (0: antenna 1, 1: antenna 2).; range 0..255 */
-    uint8_t rf_mode;  /* The packet rate index (ExpressLRS: its rate enum; Crossfire: 0 4 Hz, 1 50 Hz, 2 150 Hz).; range 0..255 */
-    uint8_t uplink_tx_power;  /* The transmitter's power.; range 0..8; enum tx_power */
-    uint8_t downlink_rssi;  /* Downlink RSSI (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t downlink_link_quality;  /* Downlink packet success rate.; unit: %; range 0..100 */
-    int8_t downlink_snr;  /* Downlink signal-to-noise ratio.; unit: dB; range -128..127 */
+    uint8_t uplink_rssi_ant1;  /* Uplink RSSI, antenna 1 (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t uplink_rssi_ant2;  /* Uplink RSSI, antenna 2 (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t uplink_link_quality;  /* Uplink packet success rate; unit: %; range 0..100 */
+    int8_t uplink_snr;  /* Uplink signal-to-noise ratio; unit: dB; range -128..127 */
+    uint8_t active_antenna;  /* The receiver's antenna in use (0: antenna 1, 1: antenna 2); range 0..255 */
+    uint8_t rf_mode;  /* The packet rate index (ExpressLRS: its rate enum; Crossfire: 0 4 Hz, 1 50 Hz, 2 150 Hz); range 0..255 */
+    uint8_t uplink_tx_power;  /* The transmitter's power; range 0..8; enum tx_power */
+    uint8_t downlink_rssi;  /* Downlink RSSI (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t downlink_link_quality;  /* Downlink packet success rate; unit: %; range 0..100 */
+    int8_t downlink_snr;  /* Downlink signal-to-noise ratio; unit: dB; range -128..127 */
 } crsf_link_statistics_request_t;
 
 /* Link statistics (CRSF_FRAMETYPE_LINK_STATISTICS) (response).  */
 typedef struct {
-    uint8_t uplink_rssi_ant1;  /* Uplink RSSI, antenna 1 (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t uplink_rssi_ant2;  /* Uplink RSSI, antenna 2 (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t uplink_link_quality;  /* Uplink packet success rate.; unit: %; range 0..100 */
-    int8_t uplink_snr;  /* Uplink signal-to-noise ratio.; unit: dB; range -128..127 */
-    uint8_t active_antenna;  /* The receiver's antenna in use (0: antenna 1, 1: antenna 2).; range 0..255 */
-    uint8_t rf_mode;  /* The packet rate index (ExpressLRS: its rate enum; Crossfire: 0 4 Hz, 1 50 Hz, 2 150 Hz).; range 0..255 */
-    uint8_t uplink_tx_power;  /* The transmitter's power.; range 0..8; enum tx_power */
-    uint8_t downlink_rssi;  /* Downlink RSSI (dBm × -1).; unit: -1 dBm; scale: -1 per unit; range 0..255 */
-    uint8_t downlink_link_quality;  /* Downlink packet success rate.; unit: %; range 0..100 */
-    int8_t downlink_snr;  /* Downlink signal-to-noise ratio.; unit: dB; range -128..127 */
+    uint8_t uplink_rssi_ant1;  /* Uplink RSSI, antenna 1 (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t uplink_rssi_ant2;  /* Uplink RSSI, antenna 2 (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t uplink_link_quality;  /* Uplink packet success rate; unit: %; range 0..100 */
+    int8_t uplink_snr;  /* Uplink signal-to-noise ratio; unit: dB; range -128..127 */
+    uint8_t active_antenna;  /* The receiver's antenna in use (0: antenna 1, 1: antenna 2); range 0..255 */
+    uint8_t rf_mode;  /* The packet rate index (ExpressLRS: its rate enum; Crossfire: 0 4 Hz, 1 50 Hz, 2 150 Hz); range 0..255 */
+    uint8_t uplink_tx_power;  /* The transmitter's power; range 0..8; enum tx_power */
+    uint8_t downlink_rssi;  /* Downlink RSSI (dBm × -1); unit: -1 dBm; scale: -1 per unit; range 0..255 */
+    uint8_t downlink_link_quality;  /* Downlink packet success rate; unit: %; range 0..100 */
+    int8_t downlink_snr;  /* Downlink signal-to-noise ratio; unit: dB; range -128..127 */
 } crsf_link_statistics_response_t;
 
 /* RC channels (CRSF_FRAMETYPE_RC_CHANNELS_PACKED) (request).  */
@@ -214,16 +214,16 @@ typedef struct {
 
 /* Attitude (CRSF_FRAMETYPE_ATTITUDE) (request).  */
 typedef struct {
-    int16_t pitch;  /* Pitch in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
-    int16_t roll;  /* Roll in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
-    int16_t yaw;  /* Yaw in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t pitch;  /* Pitch in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t roll;  /* Roll in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t yaw;  /* Yaw in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
 } crsf_attitude_request_t;
 
 /* Attitude (CRSF_FRAMETYPE_ATTITUDE) (response).  */
 typedef struct {
-    int16_t pitch;  /* Pitch in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
-    int16_t roll;  /* Roll in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
-    int16_t yaw;  /* Yaw in radians × 10000.; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t pitch;  /* Pitch in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t roll;  /* Roll in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
+    int16_t yaw;  /* Yaw in radians × 10000; unit: 100 µrad; scale: 0.0001 per unit; range -32768..32767 */
 } crsf_attitude_response_t;
 
 /* Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE) (request).  */
@@ -240,21 +240,21 @@ typedef struct {
 
 /* Device ping (CRSF_FRAMETYPE_DEVICE_PING) (request).  */
 typedef struct {
-    uint8_t destination;  /* Extended header: the address of the device the frame is for (0x00 for every device).; range 0..239; enum address */
-    uint8_t origin;  /* Extended header: the address of the device that sent the frame.; range 0..239; enum address */
+    uint8_t destination;  /* Extended header: the address of the device the frame is for (0x00 for every device); range 0..239; enum address */
+    uint8_t origin;  /* Extended header: the address of the device that sent the frame; range 0..239; enum address */
 } crsf_device_ping_request_t;
 
 /* Device info (CRSF_FRAMETYPE_DEVICE_INFO) (response).  */
 typedef struct {
-    uint8_t destination;  /* Extended header: the address of the device the frame is for (0x00 for every device).; range 0..239; enum address */
-    uint8_t origin;  /* Extended header: the address of the device that sent the frame.; range 0..239; enum address */
+    uint8_t destination;  /* Extended header: the address of the device the frame is for (0x00 for every device); range 0..239; enum address */
+    uint8_t origin;  /* Extended header: the address of the device that sent the frame; range 0..239; enum address */
     char name[CRSF_DEVICE_INFO_RESPONSE_NAME_MAX + 1u];  /* The device's name, NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t name_len;  /* bytes of text in name */
-    uint32_t serial_number;  /* Serial number (ExpressLRS: the bytes 'ELRS').; range 0..4.29497e+09 */
-    uint32_t hardware_id;  /* Hardware version.; range 0..4.29497e+09 */
-    uint32_t firmware_id;  /* Firmware version.; range 0..4.29497e+09 */
-    uint8_t parameter_count;  /* Number of parameters the device offers.; range 0..255 */
-    uint8_t parameter_version;  /* Parameter protocol version.; range 0..255 */
+    uint32_t serial_number;  /* Serial number (ExpressLRS: the bytes 'ELRS'); range 0..4.29497e+09 */
+    uint32_t hardware_id;  /* Hardware version; range 0..4.29497e+09 */
+    uint32_t firmware_id;  /* Firmware version; range 0..4.29497e+09 */
+    uint8_t parameter_count;  /* Number of parameters the device offers; range 0..255 */
+    uint8_t parameter_version;  /* Parameter protocol version; range 0..255 */
 } crsf_device_info_response_t;
 
 /* A message: which one (kind) and its fields. */

@@ -178,32 +178,32 @@ typedef enum {
 
 /* One item of ids. */
 typedef struct {
-    uint8_t id;  /* A servo id.; range 0..252 */
+    uint8_t id;  /* A servo id; range 0..252 */
 } dynamixel_p2_sync_read_request_ids_item_t;
 
 /* One item of servo_ids. */
 typedef struct {
-    uint8_t id;  /* A servo id.; range 0..252 */
+    uint8_t id;  /* A servo id; range 0..252 */
 } dynamixel_p2_fast_sync_read_request_servo_ids_item_t;
 
 /* One item of servos. */
 typedef struct {
-    uint8_t id;  /* The servo's id.; range 0..252 */
+    uint8_t id;  /* The servo's id; range 0..252 */
     uint8_t data[DYNAMIXEL_P2_SYNC_WRITE_REQUEST_SERVOS_DATA_MAX];  /* The bytes written to that servo from `address` on. */
     size_t data_len;  /* bytes in data */
 } dynamixel_p2_sync_write_request_servos_item_t;
 
 /* One item of reads. */
 typedef struct {
-    uint8_t id;  /* The servo's id.; range 0..252 */
-    uint16_t address;  /* First control table address to read.; range 0..65535 */
-    uint16_t length;  /* Number of bytes to read.; range 1..1024 */
+    uint8_t id;  /* The servo's id; range 0..252 */
+    uint16_t address;  /* First control table address to read; range 0..65535 */
+    uint16_t length;  /* Number of bytes to read; range 1..1024 */
 } dynamixel_p2_bulk_read_request_reads_item_t;
 
 /* One item of writes. */
 typedef struct {
-    uint8_t id;  /* The servo's id.; range 0..252 */
-    uint16_t address;  /* First control table address to write.; range 0..65535 */
+    uint8_t id;  /* The servo's id; range 0..252 */
+    uint16_t address;  /* First control table address to write; range 0..65535 */
     uint8_t data[DYNAMIXEL_P2_BULK_WRITE_REQUEST_WRITES_DATA_MAX];  /* The bytes written to that servo from `address` on. */
     size_t data_len;  /* bytes in data */
 } dynamixel_p2_bulk_write_request_writes_item_t;
@@ -217,21 +217,21 @@ typedef struct {
 typedef struct {
     uint8_t id;  /* frame id */
     uint8_t error;  /* frame error */
-    uint16_t model_number;  /* The servo's model number (XM430-W350: 1020, XL430-W250: 1060, XL330-M288: 1200).; range 0..65535 */
-    uint8_t firmware_version;  /* The firmware version.; range 0..255 */
+    uint16_t model_number;  /* The servo's model number (XM430-W350: 1020, XL430-W250: 1060, XL330-M288: 1200); range 0..65535 */
+    uint8_t firmware_version;  /* The firmware version; range 0..255 */
 } dynamixel_p2_ping_response_t;
 
 /* Read from the control table (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to read.; range 0..65535 */
-    uint16_t length;  /* Number of bytes to read.; range 1..1024 */
+    uint16_t address;  /* First control table address to read; range 0..65535 */
+    uint16_t length;  /* Number of bytes to read; range 1..1024 */
 } dynamixel_p2_read_request_t;
 
 /* Write to the control table (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to write.; range 0..65535 */
+    uint16_t address;  /* First control table address to write; range 0..65535 */
     uint8_t data[DYNAMIXEL_P2_WRITE_REQUEST_DATA_MAX];  /* The bytes written, item by item from `address` on. */
     size_t data_len;  /* bytes in data */
 } dynamixel_p2_write_request_t;
@@ -239,7 +239,7 @@ typedef struct {
 /* Buffered write, carried out on ACTION (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to write.; range 0..65535 */
+    uint16_t address;  /* First control table address to write; range 0..65535 */
     uint8_t data[DYNAMIXEL_P2_REG_WRITE_REQUEST_DATA_MAX];  /* The bytes to write when ACTION arrives. */
     size_t data_len;  /* bytes in data */
 } dynamixel_p2_reg_write_request_t;
@@ -252,7 +252,7 @@ typedef struct {
 /* Reset the control table to its factory values (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t option;  /* What to reset.; range 1..255; enum reset_option */
+    uint8_t option;  /* What to reset; range 1..255; enum reset_option */
 } dynamixel_p2_factory_reset_request_t;
 
 /* Reboot the servo (request).  */
@@ -263,14 +263,14 @@ typedef struct {
 /* Reset the multi-turn information (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t option;  /* What to clear.; range 1..1; enum clear_option */
+    uint8_t option;  /* What to clear; range 1..1; enum clear_option */
 } dynamixel_p2_clear_request_t;
 
 /* Read the same items of several servos (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to read.; range 0..65535 */
-    uint16_t length;  /* Number of bytes each servo returns.; range 1..1024 */
+    uint16_t address;  /* First control table address to read; range 0..65535 */
+    uint16_t length;  /* Number of bytes each servo returns; range 1..1024 */
     dynamixel_p2_sync_read_request_ids_item_t ids[DYNAMIXEL_P2_SYNC_READ_REQUEST_IDS_MAX];  /* The servos to read, in the order they answer. */
     size_t ids_count;  /* items in ids */
 } dynamixel_p2_sync_read_request_t;
@@ -278,8 +278,8 @@ typedef struct {
 /* Read the same items of several servos, answered in one packet (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to read.; range 0..65535 */
-    uint16_t length;  /* Number of bytes each servo returns.; range 1..1024 */
+    uint16_t address;  /* First control table address to read; range 0..65535 */
+    uint16_t length;  /* Number of bytes each servo returns; range 1..1024 */
     dynamixel_p2_fast_sync_read_request_servo_ids_item_t servo_ids[DYNAMIXEL_P2_FAST_SYNC_READ_REQUEST_SERVO_IDS_MAX];  /* The servos to read, in the order their parts follow each other. */
     size_t servo_ids_count;  /* items in servo_ids */
 } dynamixel_p2_fast_sync_read_request_t;
@@ -287,7 +287,7 @@ typedef struct {
 /* Write the same items of several servos at once (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint16_t address;  /* First control table address to write.; range 0..65535 */
+    uint16_t address;  /* First control table address to write; range 0..65535 */
     dynamixel_p2_sync_write_request_servos_item_t servos[DYNAMIXEL_P2_SYNC_WRITE_REQUEST_SERVOS_MAX];  /* One item per servo. */
     size_t servos_count;  /* items in servos */
 } dynamixel_p2_sync_write_request_t;

@@ -237,219 +237,219 @@ typedef struct {
 
 /* Check that a servo is online (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_ping_request_t;
 
 /* Check that a servo is online (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_ping_response_t;
 
 /* Reset the user parameters to their defaults (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_reset_user_data_request_t;
 
 /* Reset the user parameters to their defaults (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_reset_user_data_response_t;
 
 /* Read one parameter (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t data_id;  /* Parameter to read (see the parameter table).; range 0..255 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t data_id;  /* Parameter to read (see the parameter table); range 0..255 */
 } fashionstar_uart_read_data_request_t;
 
 /* Read one parameter (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t data_id;  /* The parameter read.; range 0..255 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t data_id;  /* The parameter read; range 0..255 */
     int64_t data;  /* The value, typed by data_id.; its type is the parameters entry data_id names */
 } fashionstar_uart_read_data_response_t;
 
 /* Write one user parameter (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t data_id;  /* User parameter to write (32..53).; range 0..255 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t data_id;  /* User parameter to write (32..53); range 0..255 */
     int64_t data;  /* The value, typed by data_id.; its type is the parameters entry data_id names */
 } fashionstar_uart_write_data_request_t;
 
 /* Write one user parameter (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t data_id;  /* The parameter written.; range 0..255 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t data_id;  /* The parameter written; range 0..255 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_write_data_response_t;
 
 /* Read the whole 32-byte user parameter block (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_read_batch_data_request_t;
 
 /* Read the whole 32-byte user parameter block (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
     fashionstar_uart_read_batch_data_response_user_data_t user_data;  /* The user parameters 32..53 in data_id order. */
 } fashionstar_uart_read_batch_data_response_t;
 
 /* Write the whole 32-byte user parameter block (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
     fashionstar_uart_write_batch_data_request_user_data_t user_data;  /* The user parameters 32..53 in data_id order. */
 } fashionstar_uart_write_batch_data_request_t;
 
 /* Write the whole 32-byte user parameter block (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_write_batch_data_response_t;
 
 /* Wheel mode (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t method;  /* Execution method and direction; the other bits are unused and must be zero.; range 0..255; bits direction [7:7], mode [1:0] */
-    uint16_t speed;  /* Angular speed.; unit: °/s; range 0..65535 */
-    uint16_t value;  /* Turns (mode turns) or ms (mode timed); ignored by stop and continuous.; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t method;  /* Execution method and direction; the other bits are unused and must be zero; range 0..255; bits direction [7:7], mode [1:0] */
+    uint16_t speed;  /* Angular speed; unit: °/s; range 0..65535 */
+    uint16_t value;  /* Turns (mode turns) or ms (mode timed); ignored by stop and continuous; range 0..65535 */
 } fashionstar_uart_spin_request_t;
 
 /* Wheel mode (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_spin_response_t;
 
 /* Angle mode - move to an angle (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int16_t angle;  /* Angle in 0.1° steps; the sign gives the direction (900 is 90°).; unit: 0.1°; scale: 0.1 per unit; range -32768..32767 */
-    uint16_t interval;  /* Time to reach the target angle.; unit: ms; range 0..65535 */
-    uint16_t power;  /* Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined).; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int16_t angle;  /* Angle in 0.1° steps; the sign gives the direction (900 is 90°); unit: 0.1°; scale: 0.1 per unit; range -32768..32767 */
+    uint16_t interval;  /* Time to reach the target angle; unit: ms; range 0..65535 */
+    uint16_t power;  /* Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined); unit: mW; range 0..65535 */
 } fashionstar_uart_rotate_request_t;
 
 /* Angle mode - move to an angle (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_rotate_response_t;
 
 /* Damping mode (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id; 255 sets every servo (broadcast).; range 0..255 */
-    uint16_t power;  /* Holding power; 0 or more than the power limit means the limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id; 255 sets every servo (broadcast); range 0..255 */
+    uint16_t power;  /* Holding power; 0 or more than the power limit means the limit; unit: mW; range 0..65535 */
 } fashionstar_uart_damping_request_t;
 
 /* Damping mode (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_damping_response_t;
 
 /* Read the current angle (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_read_angle_request_t;
 
 /* Read the current angle (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int16_t angle;  /* Angle in 0.1° steps; the sign gives the direction (900 is 90°).; unit: 0.1°; scale: 0.1 per unit; range -32768..32767 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int16_t angle;  /* Angle in 0.1° steps; the sign gives the direction (900 is 90°); unit: 0.1°; scale: 0.1 per unit; range -32768..32767 */
 } fashionstar_uart_read_angle_response_t;
 
 /* Move to an angle in a time, with acceleration and deceleration times (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int16_t angle;  /* Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range).; unit: 0.1°; scale: 0.1 per unit; range -1800..1800 */
-    uint16_t interval;  /* Time to reach the target angle.; unit: ms; range 0..65535 */
-    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int16_t angle;  /* Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range); unit: 0.1°; scale: 0.1 per unit; range -1800..1800 */
+    uint16_t interval;  /* Time to reach the target angle; unit: ms; range 0..65535 */
+    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit; unit: mW; range 0..65535 */
 } fashionstar_uart_move_by_interval_request_t;
 
 /* Move to an angle in a time, with acceleration and deceleration times (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_move_by_interval_response_t;
 
 /* Move to an angle at a speed, with acceleration and deceleration times (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int16_t angle;  /* Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range).; unit: 0.1°; scale: 0.1 per unit; range -1800..1800 */
-    uint16_t velocity;  /* Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s).; unit: 0.1°/s; scale: 0.1 per unit; range 10..7500 */
-    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int16_t angle;  /* Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range); unit: 0.1°; scale: 0.1 per unit; range -1800..1800 */
+    uint16_t velocity;  /* Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s); unit: 0.1°/s; scale: 0.1 per unit; range 10..7500 */
+    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit; unit: mW; range 0..65535 */
 } fashionstar_uart_move_by_velocity_request_t;
 
 /* Move to an angle at a speed, with acceleration and deceleration times (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_move_by_velocity_response_t;
 
 /* Multi-turn move to an angle in a time (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°).; unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
-    uint32_t interval;  /* Time to reach the target angle.; unit: ms; range 0..4.096e+06 */
-    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°); unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
+    uint32_t interval;  /* Time to reach the target angle; unit: ms; range 0..4.096e+06 */
+    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit; unit: mW; range 0..65535 */
 } fashionstar_uart_move_mturn_request_t;
 
 /* Multi-turn move to an angle in a time (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_move_mturn_response_t;
 
 /* Multi-turn move in a time, with acceleration and deceleration times (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°).; unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
-    uint32_t interval;  /* Time to reach the target (at least t_acc + t_dec).; unit: ms; range 0..4.096e+06 */
-    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°); unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
+    uint32_t interval;  /* Time to reach the target (at least t_acc + t_dec); unit: ms; range 0..4.096e+06 */
+    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit; unit: mW; range 0..65535 */
 } fashionstar_uart_move_mturn_by_interval_request_t;
 
 /* Multi-turn move in a time, with acceleration and deceleration times (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_move_mturn_by_interval_response_t;
 
 /* Multi-turn move at a speed, with acceleration and deceleration times (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°).; unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
-    uint16_t velocity;  /* Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s).; unit: 0.1°/s; scale: 0.1 per unit; range 10..7500 */
-    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms).; unit: ms; range 0..65535 */
-    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit.; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°); unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
+    uint16_t velocity;  /* Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s); unit: 0.1°/s; scale: 0.1 per unit; range 10..7500 */
+    uint16_t t_acc;  /* Acceleration time at the start of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t t_dec;  /* Deceleration time at the end of the move (the SDK sends at least 20 ms); unit: ms; range 0..65535 */
+    uint16_t power;  /* Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit; unit: mW; range 0..65535 */
 } fashionstar_uart_move_mturn_by_velocity_request_t;
 
 /* Multi-turn move at a speed, with acceleration and deceleration times (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t result;  /* Outcome of the command.; range 0..1; enum result */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t result;  /* Outcome of the command; range 0..1; enum result */
 } fashionstar_uart_move_mturn_by_velocity_response_t;
 
 /* Read the multi-turn angle and turn count (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_read_mturn_angle_request_t;
 
 /* Read the multi-turn angle and turn count (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°).; unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
-    int16_t turns;  /* Whole turns in the multi-turn angle (toward zero).; range -32768..32767 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°); unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
+    int16_t turns;  /* Whole turns in the multi-turn angle (toward zero); range -32768..32767 */
 } fashionstar_uart_read_mturn_angle_response_t;
 
 /* Reset the multi-turn angle (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_reset_mturn_angle_request_t;
 
 /* Begin holding move commands (request).  */
@@ -459,41 +459,41 @@ typedef struct {
 
 /* Run (or drop) the held move commands (request).  */
 typedef struct {
-    uint8_t mode;  /* 0 runs the held commands, 1 drops them.; range 0..1; enum async_end */
+    uint8_t mode;  /* 0 runs the held commands, 1 drops them; range 0..1; enum async_end */
 } fashionstar_uart_end_async_request_t;
 
 /* Read voltage, current, power, temperature, status and multi-turn angle at once (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_monitor_request_t;
 
 /* Read voltage, current, power, temperature, status and multi-turn angle at once (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint16_t voltage;  /* Supply voltage (as data_id 1).; unit: mV; range 0..65535 */
-    uint16_t current;  /* Current (as data_id 2).; unit: mA; range 0..65535 */
-    uint16_t power;  /* Power (as data_id 3).; unit: mW; range 0..65535 */
-    uint16_t temperature;  /* Raw NTC reading (as data_id 4; see erratum temperature_unit).; unit: raw ADC; range 0..65535 */
-    uint8_t status;  /* Working status (as data_id 5).; range 0..255 */
-    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°).; unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
-    int16_t turns;  /* Whole turns in the multi-turn angle (toward zero).; range -32768..32767 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint16_t voltage;  /* Supply voltage (as data_id 1); unit: mV; range 0..65535 */
+    uint16_t current;  /* Current (as data_id 2); unit: mA; range 0..65535 */
+    uint16_t power;  /* Power (as data_id 3); unit: mW; range 0..65535 */
+    uint16_t temperature;  /* Raw NTC reading (as data_id 4; see erratum temperature_unit); unit: raw ADC; range 0..65535 */
+    uint8_t status;  /* Working status (as data_id 5); range 0..255 */
+    int32_t angle;  /* Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°); unit: 0.1°; scale: 0.1 per unit; range -3.6864e+06..3.6864e+06 */
+    int16_t turns;  /* Whole turns in the multi-turn angle (toward zero); range -32768..32767 */
 } fashionstar_uart_monitor_response_t;
 
 /* Make the present position the origin (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
 } fashionstar_uart_set_origin_point_request_t;
 
 /* Stop the move, then release, hold or damp (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo).; range 0..254 */
-    uint8_t method;  /* What the servo does after stopping.; range 16..18; enum stop_method */
-    uint16_t power;  /* Holding power (hold and damping).; unit: mW; range 0..65535 */
+    uint8_t servo_id;  /* Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo); range 0..254 */
+    uint8_t method;  /* What the servo does after stopping; range 16..18; enum stop_method */
+    uint16_t power;  /* Holding power (hold and damping); unit: mW; range 0..65535 */
 } fashionstar_uart_stop_on_control_mode_request_t;
 
 /* One command for several servos at once (request).  */
 typedef struct {
-    uint8_t command;  /* The command carried (8, 11..15, or 22 for the monitor).; range 0..255 */
+    uint8_t command;  /* The command carried (8, 11..15, or 22 for the monitor); range 0..255 */
     fashionstar_uart_sync_command_request_blocks_item_t blocks[FASHIONSTAR_UART_SYNC_COMMAND_REQUEST_BLOCKS_MAX];  /* One block per servo. */
     size_t blocks_count;  /* items in blocks */
 } fashionstar_uart_sync_command_request_t;

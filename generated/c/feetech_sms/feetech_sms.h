@@ -146,12 +146,12 @@ typedef enum {
 
 /* One item of ids. */
 typedef struct {
-    uint8_t id;  /* A servo id.; range 0..253 */
+    uint8_t id;  /* A servo id; range 0..253 */
 } feetech_sms_sync_read_request_ids_item_t;
 
 /* One item of servos. */
 typedef struct {
-    uint8_t id;  /* The servo's id.; range 0..253 */
+    uint8_t id;  /* The servo's id; range 0..253 */
     uint8_t data[FEETECH_SMS_SYNC_WRITE_REQUEST_SERVOS_DATA_MAX];  /* The L bytes written to that servo from `address` on. */
     size_t data_len;  /* bytes in data */
 } feetech_sms_sync_write_request_servos_item_t;
@@ -164,14 +164,14 @@ typedef struct {
 /* Read from the control table (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t address;  /* First register address to read.; range 0..255 */
-    uint8_t length;  /* Number of bytes to read.; range 1..250 */
+    uint8_t address;  /* First register address to read; range 0..255 */
+    uint8_t length;  /* Number of bytes to read; range 1..250 */
 } feetech_sms_read_request_t;
 
 /* Write to the control table (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t address;  /* First register address to write.; range 0..255 */
+    uint8_t address;  /* First register address to write; range 0..255 */
     uint8_t data[FEETECH_SMS_WRITE_REQUEST_DATA_MAX];  /* The bytes written, register by register from `address` on. */
     size_t data_len;  /* bytes in data */
 } feetech_sms_write_request_t;
@@ -179,7 +179,7 @@ typedef struct {
 /* Buffered write, run on ACTION (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t address;  /* First register address to write.; range 0..255 */
+    uint8_t address;  /* First register address to write; range 0..255 */
     uint8_t data[FEETECH_SMS_REG_WRITE_REQUEST_DATA_MAX];  /* The bytes to write when ACTION arrives. */
     size_t data_len;  /* bytes in data */
 } feetech_sms_reg_write_request_t;
@@ -197,8 +197,8 @@ typedef struct {
 /* Read the same registers of several servos (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t address;  /* First register address to read.; range 0..255 */
-    uint8_t length;  /* Number of bytes each servo returns.; range 1..250 */
+    uint8_t address;  /* First register address to read; range 0..255 */
+    uint8_t length;  /* Number of bytes each servo returns; range 1..250 */
     feetech_sms_sync_read_request_ids_item_t ids[FEETECH_SMS_SYNC_READ_REQUEST_IDS_MAX];  /* The servos to read, in the order they answer. */
     size_t ids_count;  /* items in ids */
 } feetech_sms_sync_read_request_t;
@@ -206,7 +206,7 @@ typedef struct {
 /* Write the same registers of several servos at once (request).  */
 typedef struct {
     uint8_t id;  /* frame id */
-    uint8_t address;  /* First register address to write.; range 0..255 */
+    uint8_t address;  /* First register address to write; range 0..255 */
     feetech_sms_sync_write_request_servos_item_t servos[FEETECH_SMS_SYNC_WRITE_REQUEST_SERVOS_MAX];  /* One item per servo. */
     size_t servos_count;  /* items in servos */
 } feetech_sms_sync_write_request_t;

@@ -195,61 +195,61 @@ typedef enum {
 
 /* One item of motors. */
 typedef struct {
-    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).; range 0..255 */
-    float speed;  /* Motor speed in revolutions per second; the sign gives the direction.; unit: r/s */
+    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports); range 0..255 */
+    float speed;  /* Motor speed in revolutions per second; the sign gives the direction; unit: r/s */
 } hiwonder_rrc_motor_set_speeds_request_motors_item_t;
 
 /* One item of duties. */
 typedef struct {
-    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).; range 0..255 */
-    float duty;  /* Duty cycle; the sign gives the direction (the SDK's example uses ±50).; unit: % */
+    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports); range 0..255 */
+    float duty;  /* Duty cycle; the sign gives the direction (the SDK's example uses ±50); unit: % */
 } hiwonder_rrc_motor_set_duties_request_duties_item_t;
 
 /* One item of pwm_servos. */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
-    uint16_t pulse;  /* PWM pulse width (脉冲宽度); 500..2500 is 0°..180°.; unit: µs; range 500..2500 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
+    uint16_t pulse;  /* PWM pulse width (脉冲宽度); 500..2500 is 0°..180°; unit: µs; range 500..2500 */
 } hiwonder_rrc_pwm_servo_set_positions_request_pwm_servos_item_t;
 
 /* One item of bus_servos. */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    uint16_t position;  /* Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°.; range 0..1000 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    uint16_t position;  /* Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°; range 0..1000 */
 } hiwonder_rrc_bus_servo_set_positions_request_bus_servos_item_t;
 
 /* One item of servos. */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_stop_request_servos_item_t;
 
 /* One item of pixels. */
 typedef struct {
-    uint8_t index;  /* LED index from 0 (the SDK takes 1.. and sends it less one).; range 0..255 */
-    uint8_t red;  /* Red 0..255.; range 0..255 */
-    uint8_t green;  /* Green 0..255.; range 0..255 */
-    uint8_t blue;  /* Blue 0..255.; range 0..255 */
+    uint8_t index;  /* LED index from 0 (the SDK takes 1.. and sends it less one); range 0..255 */
+    uint8_t red;  /* Red 0..255; range 0..255 */
+    uint8_t green;  /* Green 0..255; range 0..255 */
+    uint8_t blue;  /* Blue 0..255; range 0..255 */
 } hiwonder_rrc_rgb_set_pixels_request_pixels_item_t;
 
 /* Blink the LED (request).  */
 typedef struct {
-    uint8_t led_id;  /* LED id.; range 0..255 */
-    uint16_t on_time;  /* Time on (亮的时间).; unit: ms; range 0..65535 */
-    uint16_t off_time;  /* Time off (灭的时间).; unit: ms; range 0..65535 */
-    uint16_t repeat;  /* Number of blinks (循环次数).; range 0..65535 */
+    uint8_t led_id;  /* LED id; range 0..255 */
+    uint16_t on_time;  /* Time on (亮的时间); unit: ms; range 0..65535 */
+    uint16_t off_time;  /* Time off (灭的时间); unit: ms; range 0..65535 */
+    uint16_t repeat;  /* Number of blinks (循环次数); range 0..65535 */
 } hiwonder_rrc_led_request_t;
 
 /* Sound the buzzer (request).  */
 typedef struct {
-    uint16_t frequency;  /* Tone frequency (频率).; unit: Hz; range 0..65535 */
-    uint16_t on_time;  /* Time sounding (响的时间).; unit: ms; range 0..65535 */
-    uint16_t off_time;  /* Time silent (不响的时间).; unit: ms; range 0..65535 */
-    uint16_t repeat;  /* Number of beeps (循环次数).; range 0..65535 */
+    uint16_t frequency;  /* Tone frequency (频率); unit: Hz; range 0..65535 */
+    uint16_t on_time;  /* Time sounding (响的时间); unit: ms; range 0..65535 */
+    uint16_t off_time;  /* Time silent (不响的时间); unit: ms; range 0..65535 */
+    uint16_t repeat;  /* Number of beeps (循环次数); range 0..65535 */
 } hiwonder_rrc_buzzer_request_t;
 
 /* Encoder motors (request).  */
 typedef struct {
-    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).; range 0..255 */
-    float speed;  /* Motor speed in revolutions per second; the sign gives the direction.; unit: r/s */
+    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports); range 0..255 */
+    float speed;  /* Motor speed in revolutions per second; the sign gives the direction; unit: r/s */
 } hiwonder_rrc_motor_set_speed_request_t;
 
 /* Encoder motors (request).  */
@@ -260,7 +260,7 @@ typedef struct {
 
 /* Encoder motors (request).  */
 typedef struct {
-    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).; range 0..255 */
+    uint8_t motor_id;  /* Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports); range 0..255 */
 } hiwonder_rrc_motor_stop_request_t;
 
 /* Encoder motors (request).  */
@@ -271,92 +271,92 @@ typedef struct {
 
 /* Encoder motors (request).  */
 typedef struct {
-    uint8_t mask;  /* Motors to stop (电机掩码), bit n for motor n.; range 0..255 */
+    uint8_t mask;  /* Motors to stop (电机掩码), bit n for motor n; range 0..255 */
 } hiwonder_rrc_motor_stop_mask_request_t;
 
 /* PWM servos (request).  */
 typedef struct {
-    uint16_t duration;  /* Time to complete the move (运动时间).; unit: ms; range 0..65535 */
+    uint16_t duration;  /* Time to complete the move (运动时间); unit: ms; range 0..65535 */
     hiwonder_rrc_pwm_servo_set_positions_request_pwm_servos_item_t pwm_servos[HIWONDER_RRC_PWM_SERVO_SET_POSITIONS_REQUEST_PWM_SERVOS_MAX];  /* One (servo_id, pulse) pair per servo. */
     size_t pwm_servos_count;  /* items in pwm_servos */
 } hiwonder_rrc_pwm_servo_set_positions_request_t;
 
 /* PWM servos (request).  */
 typedef struct {
-    uint16_t duration;  /* Time to complete the move (运动时间).; unit: ms; range 0..65535 */
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
-    uint16_t pulse;  /* PWM pulse width (脉冲宽度); 500..2500 is 0°..180°.; unit: µs; range 500..2500 */
+    uint16_t duration;  /* Time to complete the move (运动时间); unit: ms; range 0..65535 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
+    uint16_t pulse;  /* PWM pulse width (脉冲宽度); 500..2500 is 0°..180°; unit: µs; range 500..2500 */
 } hiwonder_rrc_pwm_servo_set_position_request_t;
 
 /* PWM servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
 } hiwonder_rrc_pwm_servo_read_position_request_t;
 
 /* PWM servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
-    uint16_t pulse;  /* The servo's current pulse width (not range-checked in a report).; unit: µs; range 0..65535 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
+    uint16_t pulse;  /* The servo's current pulse width (not range-checked in a report); unit: µs; range 0..65535 */
 } hiwonder_rrc_pwm_servo_read_position_response_t;
 
 /* PWM servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
-    int8_t offset;  /* PWM servo offset (偏差), an int8 from -100 to +100.; unit: µs; range -100..100 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
+    int8_t offset;  /* PWM servo offset (偏差), an int8 from -100 to +100; unit: µs; range -100..100 */
 } hiwonder_rrc_pwm_servo_set_offset_request_t;
 
 /* PWM servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
 } hiwonder_rrc_pwm_servo_read_offset_request_t;
 
 /* PWM servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* PWM servo id.; range 0..255 */
-    int8_t offset;  /* The servo's offset (int8; -100..100 when set through 0x07).; unit: µs; range -128..127 */
+    uint8_t servo_id;  /* PWM servo id; range 0..255 */
+    int8_t offset;  /* The servo's offset (int8; -100..100 when set through 0x07); unit: µs; range -128..127 */
 } hiwonder_rrc_pwm_servo_read_offset_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint16_t duration;  /* Time to complete the move (运动时间).; unit: ms; range 0..65535 */
+    uint16_t duration;  /* Time to complete the move (运动时间); unit: ms; range 0..65535 */
     hiwonder_rrc_bus_servo_set_positions_request_bus_servos_item_t bus_servos[HIWONDER_RRC_BUS_SERVO_SET_POSITIONS_REQUEST_BUS_SERVOS_MAX];  /* One (servo_id, position) pair per servo. */
     size_t bus_servos_count;  /* items in bus_servos */
 } hiwonder_rrc_bus_servo_set_positions_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_position_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    int16_t position;  /* Current position (0..1000 is 0°..240°).; range -32768..32767 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    int16_t position;  /* Current position (0..1000 is 0°..240°); range -32768..32767 */
 } hiwonder_rrc_bus_servo_read_position_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_voltage_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint16_t voltage;  /* Input voltage.; unit: mV; range 0..65535 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint16_t voltage;  /* Input voltage; unit: mV; range 0..65535 */
 } hiwonder_rrc_bus_servo_read_voltage_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_temperature_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint8_t temperature;  /* Temperature.; unit: °C; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint8_t temperature;  /* Temperature; unit: °C; range 0..255 */
 } hiwonder_rrc_bus_servo_read_temperature_response_t;
 
 /* Bus servos (request).  */
@@ -367,129 +367,129 @@ typedef struct {
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_torque_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    int8_t torque;  /* 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).; range -128..127 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    int8_t torque;  /* 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B); range -128..127 */
 } hiwonder_rrc_bus_servo_read_torque_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_unload_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_load_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* The servo's current id.; range 0..255 */
-    uint8_t new_id;  /* The id to store (save_id).; range 0..255 */
+    uint8_t servo_id;  /* The servo's current id; range 0..255 */
+    uint8_t new_id;  /* The id to store (save_id); range 0..255 */
 } hiwonder_rrc_bus_servo_set_id_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* 0xFE (broadcast query, 查询广播).; range 0..255 */
+    uint8_t servo_id;  /* 0xFE (broadcast query, 查询广播); range 0..255 */
 } hiwonder_rrc_bus_servo_read_id_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* The id the request was sent to (0xFE for the broadcast).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint8_t id;  /* The id read from the servo.; range 0..255 */
+    uint8_t servo_id;  /* The id the request was sent to (0xFE for the broadcast); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint8_t id;  /* The id read from the servo; range 0..255 */
 } hiwonder_rrc_bus_servo_read_id_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t offset;  /* Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range).; range -125..125 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t offset;  /* Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range); range -125..125 */
 } hiwonder_rrc_bus_servo_set_offset_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_offset_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    int8_t offset;  /* The servo's offset (int8; -125..125 when set through 0x20).; range -128..127 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    int8_t offset;  /* The servo's offset (int8; -125..125 when set through 0x20); range -128..127 */
 } hiwonder_rrc_bus_servo_read_offset_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_save_offset_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    uint16_t low;  /* Low position limit (低限位), 0..1000.; range 0..1000 */
-    uint16_t high;  /* High position limit (高限位), 0..1000.; range 0..1000 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    uint16_t low;  /* Low position limit (低限位), 0..1000; range 0..1000 */
+    uint16_t high;  /* High position limit (高限位), 0..1000; range 0..1000 */
 } hiwonder_rrc_bus_servo_set_position_limit_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_position_limit_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint16_t low;  /* Low position limit.; range 0..65535 */
-    uint16_t high;  /* High position limit.; range 0..65535 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint16_t low;  /* Low position limit; range 0..65535 */
+    uint16_t high;  /* High position limit; range 0..65535 */
 } hiwonder_rrc_bus_servo_read_position_limit_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    uint16_t low;  /* Low voltage limit (低限位), at least 4500 mV.; unit: mV; range 4500..14000 */
-    uint16_t high;  /* High voltage limit (高限位), at most 14000 mV.; unit: mV; range 4500..14000 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    uint16_t low;  /* Low voltage limit (低限位), at least 4500 mV; unit: mV; range 4500..14000 */
+    uint16_t high;  /* High voltage limit (高限位), at most 14000 mV; unit: mV; range 4500..14000 */
 } hiwonder_rrc_bus_servo_set_voltage_limit_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_voltage_limit_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint16_t low;  /* Low voltage limit.; unit: mV; range 0..65535 */
-    uint16_t high;  /* High voltage limit.; unit: mV; range 0..65535 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint16_t low;  /* Low voltage limit; unit: mV; range 0..65535 */
+    uint16_t high;  /* High voltage limit; unit: mV; range 0..65535 */
 } hiwonder_rrc_bus_servo_read_voltage_limit_response_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    uint8_t limit;  /* Over-temperature threshold (高温阈值); must be less than 100 °C.; unit: °C; range 0..99 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    uint8_t limit;  /* Over-temperature threshold (高温阈值); must be less than 100 °C; unit: °C; range 0..99 */
 } hiwonder_rrc_bus_servo_set_temperature_limit_request_t;
 
 /* Bus servos (request).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
 } hiwonder_rrc_bus_servo_read_temperature_limit_request_t;
 
 /* Bus servos (response).  */
 typedef struct {
-    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id).; range 0..255 */
-    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.; range -1..0; enum read_result */
-    uint8_t limit;  /* Over-temperature threshold.; unit: °C; range 0..255 */
+    uint8_t servo_id;  /* Bus servo id (0xFE is the broadcast id); range 0..255 */
+    int8_t success;  /* Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0; range -1..0; enum read_result */
+    uint8_t limit;  /* Over-temperature threshold; unit: °C; range 0..255 */
 } hiwonder_rrc_bus_servo_read_temperature_limit_response_t;
 
 /* Key event (response).  */
 typedef struct {
-    uint8_t button_id;  /* Button id.; range 0..255 */
-    uint8_t event;  /* What happened to the button (按键事件).; range 1..128; enum button_event */
+    uint8_t button_id;  /* Button id; range 0..255 */
+    uint8_t event;  /* What happened to the button (按键事件); range 1..128; enum button_event */
 } hiwonder_rrc_key_response_t;
 
 /* IMU data (response).  */
@@ -504,31 +504,31 @@ typedef struct {
 
 /* Gamepad data (response).  */
 typedef struct {
-    uint16_t buttons;  /* Buttons held (按键), one bit per button (bits from the SDK).; range 0..65535 */
-    uint8_t hat;  /* Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented.; range 0..255 */
-    int8_t left_x;  /* Left stick x.; range -128..127 */
-    int8_t left_y;  /* Left stick y.; range -128..127 */
-    int8_t right_x;  /* Right stick x.; range -128..127 */
-    int8_t right_y;  /* Right stick y.; range -128..127 */
+    uint16_t buttons;  /* Buttons held (按键), one bit per button (bits from the SDK); range 0..65535 */
+    uint8_t hat;  /* Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented; range 0..255 */
+    int8_t left_x;  /* Left stick x; range -128..127 */
+    int8_t left_y;  /* Left stick y; range -128..127 */
+    int8_t right_x;  /* Right stick x; range -128..127 */
+    int8_t right_y;  /* Right stick y; range -128..127 */
 } hiwonder_rrc_gamepad_response_t;
 
 /* SBUS radio-control receiver data (response).  */
 typedef struct {
-    int16_t channels[16];  /* The 16 proportional channels.; range -32768..32767 */
-    uint8_t ch17;  /* Digital channel 17.; range 0..255 */
-    uint8_t ch18;  /* Digital channel 18.; range 0..255 */
-    uint8_t signal_loss;  /* Set when the receiver has lost the signal.; range 0..255 */
-    uint8_t fail_safe;  /* Set when the receiver is in fail-safe.; range 0..255 */
+    int16_t channels[16];  /* The 16 proportional channels; range -32768..32767 */
+    uint8_t ch17;  /* Digital channel 17; range 0..255 */
+    uint8_t ch18;  /* Digital channel 18; range 0..255 */
+    uint8_t signal_loss;  /* Set when the receiver has lost the signal; range 0..255 */
+    uint8_t fail_safe;  /* Set when the receiver is in fail-safe; range 0..255 */
 } hiwonder_rrc_sbus_response_t;
 
 /* System reports (battery voltage) (response).  */
 typedef struct {
-    uint16_t voltage;  /* Battery voltage.; unit: mV; range 0..65535 */
+    uint16_t voltage;  /* Battery voltage; unit: mV; range 0..65535 */
 } hiwonder_rrc_system_battery_response_t;
 
 /* Show a line of text on the OLED display (request).  */
 typedef struct {
-    uint8_t line;  /* Display line (1 or 2 in the SDK's example).; range 0..255 */
+    uint8_t line;  /* Display line (1 or 2 in the SDK's example); range 0..255 */
     uint8_t text[HIWONDER_RRC_OLED_REQUEST_TEXT_MAX];  /* The text (UTF-8). */
     size_t text_len;  /* bytes in text */
 } hiwonder_rrc_oled_request_t;

@@ -235,12 +235,12 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    uint32_t custom_mode;  /* Autopilot-specific flight mode (PX4 and ArduPilot number their modes differently).; range 0..4.29497e+09 */
-    uint8_t type;  /* The kind of vehicle or component.; range 0..255; enum mav_type */
-    uint8_t autopilot;  /* The autopilot firmware.; range 0..255; enum mav_autopilot */
-    uint8_t base_mode;  /* The system mode bits (armed, manual input, ...).; range 0..255 */
-    uint8_t system_status;  /* The system status (standby, active, ...).; range 0..255; enum mav_state */
-    uint8_t mavlink_version;  /* The MAVLink version the sender implements (3: the current version).; range 0..255 */
+    uint32_t custom_mode;  /* Autopilot-specific flight mode (PX4 and ArduPilot number their modes differently); range 0..4.29497e+09 */
+    uint8_t type;  /* The kind of vehicle or component; range 0..255; enum mav_type */
+    uint8_t autopilot;  /* The autopilot firmware; range 0..255; enum mav_autopilot */
+    uint8_t base_mode;  /* The system mode bits (armed, manual input, ...); range 0..255 */
+    uint8_t system_status;  /* The system status (standby, active, ...); range 0..255; enum mav_state */
+    uint8_t mavlink_version;  /* The MAVLink version the sender implements (3: the current version); range 0..255 */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_heartbeat_response_t;
@@ -250,22 +250,22 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    uint32_t onboard_control_sensors_present;  /* MAV_SYS_STATUS_SENSOR bits of the sensors present.; range 0..4.29497e+09 */
-    uint32_t onboard_control_sensors_enabled;  /* MAV_SYS_STATUS_SENSOR bits of the sensors enabled.; range 0..4.29497e+09 */
-    uint32_t onboard_control_sensors_health;  /* MAV_SYS_STATUS_SENSOR bits of the sensors healthy (1: healthy).; range 0..4.29497e+09 */
-    uint16_t load;  /* Main loop load, 0..1000 (1000 = 100 %).; unit: 0.1%; scale: 0.1 per unit; range 0..65535 */
-    uint16_t voltage_battery;  /* Battery voltage (65535 when unknown).; unit: mV; range 0..65535 */
-    int16_t current_battery;  /* Battery current (-1 when unknown).; unit: 10 mA; scale: 10 per unit; range -32768..32767 */
-    uint16_t drop_rate_comm;  /* Share of packets dropped on all links.; unit: 0.01%; scale: 0.01 per unit; range 0..65535 */
-    uint16_t errors_comm;  /* Communication errors (UART, I2C, SPI, CAN) dropping packets.; range 0..65535 */
-    uint16_t errors_count1;  /* Autopilot-specific error count.; range 0..65535 */
-    uint16_t errors_count2;  /* Autopilot-specific error count.; range 0..65535 */
-    uint16_t errors_count3;  /* Autopilot-specific error count.; range 0..65535 */
-    uint16_t errors_count4;  /* Autopilot-specific error count.; range 0..65535 */
-    int8_t battery_remaining;  /* Battery energy left, 0..100 (-1 when unknown).; unit: %; range -128..127 */
-    uint32_t onboard_control_sensors_present_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors present.; range 0..4.29497e+09 */
-    uint32_t onboard_control_sensors_enabled_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors enabled.; range 0..4.29497e+09 */
-    uint32_t onboard_control_sensors_health_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors healthy.; range 0..4.29497e+09 */
+    uint32_t onboard_control_sensors_present;  /* MAV_SYS_STATUS_SENSOR bits of the sensors present; range 0..4.29497e+09 */
+    uint32_t onboard_control_sensors_enabled;  /* MAV_SYS_STATUS_SENSOR bits of the sensors enabled; range 0..4.29497e+09 */
+    uint32_t onboard_control_sensors_health;  /* MAV_SYS_STATUS_SENSOR bits of the sensors healthy (1: healthy); range 0..4.29497e+09 */
+    uint16_t load;  /* Main loop load, 0..1000 (1000 = 100 %); unit: 0.1%; scale: 0.1 per unit; range 0..65535 */
+    uint16_t voltage_battery;  /* Battery voltage (65535 when unknown); unit: mV; range 0..65535 */
+    int16_t current_battery;  /* Battery current (-1 when unknown); unit: 10 mA; scale: 10 per unit; range -32768..32767 */
+    uint16_t drop_rate_comm;  /* Share of packets dropped on all links; unit: 0.01%; scale: 0.01 per unit; range 0..65535 */
+    uint16_t errors_comm;  /* Communication errors (UART, I2C, SPI, CAN) dropping packets; range 0..65535 */
+    uint16_t errors_count1;  /* Autopilot-specific error count; range 0..65535 */
+    uint16_t errors_count2;  /* Autopilot-specific error count; range 0..65535 */
+    uint16_t errors_count3;  /* Autopilot-specific error count; range 0..65535 */
+    uint16_t errors_count4;  /* Autopilot-specific error count; range 0..65535 */
+    int8_t battery_remaining;  /* Battery energy left, 0..100 (-1 when unknown); unit: %; range -128..127 */
+    uint32_t onboard_control_sensors_present_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors present; range 0..4.29497e+09 */
+    uint32_t onboard_control_sensors_enabled_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors enabled; range 0..4.29497e+09 */
+    uint32_t onboard_control_sensors_health_extended;  /* Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors healthy; range 0..4.29497e+09 */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_sys_status_response_t;
@@ -275,9 +275,9 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    int16_t param_index;  /* The parameter's index, or -1 to name it by param_id.; range -32768..32767 */
-    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system).; range 0..255 */
-    uint8_t target_component;  /* Component id of the component the message is for (0 for every component).; range 0..255 */
+    int16_t param_index;  /* The parameter's index, or -1 to name it by param_id; range -32768..32767 */
+    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system); range 0..255 */
+    uint8_t target_component;  /* Component id of the component the message is for (0 for every component); range 0..255 */
     char param_id[MAVLINK_COMMON_PARAM_REQUEST_READ_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
     bool has_signature;  /* signature sent (encode: send it) */
@@ -290,11 +290,11 @@ typedef struct {
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
     float param_value;  /* The parameter's value (integer parameters are sent as the float of the same value). */
-    uint16_t param_count;  /* How many parameters the component has.; range 0..65535 */
-    uint16_t param_index;  /* The parameter's index (65535 when not known, e.g. after PARAM_SET).; range 0..65535 */
+    uint16_t param_count;  /* How many parameters the component has; range 0..65535 */
+    uint16_t param_index;  /* The parameter's index (65535 when not known, e.g. after PARAM_SET); range 0..65535 */
     char param_id[MAVLINK_COMMON_PARAM_VALUE_RESPONSE_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
-    uint8_t param_type;  /* The type of the parameter's value.; range 0..255; enum mav_param_type */
+    uint8_t param_type;  /* The type of the parameter's value; range 0..255; enum mav_param_type */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_param_value_response_t;
@@ -305,11 +305,11 @@ typedef struct {
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
     float param_value;  /* The parameter's value (integer parameters are sent as the float of the same value). */
-    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system).; range 0..255 */
-    uint8_t target_component;  /* Component id of the component the message is for (0 for every component).; range 0..255 */
+    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system); range 0..255 */
+    uint8_t target_component;  /* Component id of the component the message is for (0 for every component); range 0..255 */
     char param_id[MAVLINK_COMMON_PARAM_SET_REQUEST_PARAM_ID_MAX + 1u];  /* The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used). (in C: UTF-8, NUL-terminated) */
     size_t param_id_len;  /* bytes of text in param_id */
-    uint8_t param_type;  /* The type of the parameter's value.; range 0..255; enum mav_param_type */
+    uint8_t param_type;  /* The type of the parameter's value; range 0..255; enum mav_param_type */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_param_set_request_t;
@@ -319,13 +319,13 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    uint32_t time_boot_ms;  /* Time since the system booted.; unit: ms; range 0..4.29497e+09 */
-    float roll;  /* Roll angle (-pi..+pi).; unit: rad */
-    float pitch;  /* Pitch angle (-pi..+pi).; unit: rad */
-    float yaw;  /* Yaw angle (-pi..+pi).; unit: rad */
-    float rollspeed;  /* Roll angular speed.; unit: rad/s */
-    float pitchspeed;  /* Pitch angular speed.; unit: rad/s */
-    float yawspeed;  /* Yaw angular speed.; unit: rad/s */
+    uint32_t time_boot_ms;  /* Time since the system booted; unit: ms; range 0..4.29497e+09 */
+    float roll;  /* Roll angle (-pi..+pi); unit: rad */
+    float pitch;  /* Pitch angle (-pi..+pi); unit: rad */
+    float yaw;  /* Yaw angle (-pi..+pi); unit: rad */
+    float rollspeed;  /* Roll angular speed; unit: rad/s */
+    float pitchspeed;  /* Pitch angular speed; unit: rad/s */
+    float yawspeed;  /* Yaw angular speed; unit: rad/s */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_attitude_response_t;
@@ -335,15 +335,15 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    uint32_t time_boot_ms;  /* Time since the system booted.; unit: ms; range 0..4.29497e+09 */
-    int32_t lat;  /* Latitude (WGS84).; unit: 1e-7°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t lon;  /* Longitude (WGS84).; unit: 1e-7°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t alt;  /* Altitude above mean sea level.; unit: mm; range -2.14748e+09..2.14748e+09 */
-    int32_t relative_alt;  /* Altitude above the home position.; unit: mm; range -2.14748e+09..2.14748e+09 */
-    int16_t vx;  /* Ground speed north.; unit: cm/s; range -32768..32767 */
-    int16_t vy;  /* Ground speed east.; unit: cm/s; range -32768..32767 */
-    int16_t vz;  /* Ground speed down.; unit: cm/s; range -32768..32767 */
-    uint16_t hdg;  /* Heading (yaw) 0..35999; 65535 when not known.; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
+    uint32_t time_boot_ms;  /* Time since the system booted; unit: ms; range 0..4.29497e+09 */
+    int32_t lat;  /* Latitude (WGS84); unit: 1e-7°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t lon;  /* Longitude (WGS84); unit: 1e-7°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t alt;  /* Altitude above mean sea level; unit: mm; range -2.14748e+09..2.14748e+09 */
+    int32_t relative_alt;  /* Altitude above the home position; unit: mm; range -2.14748e+09..2.14748e+09 */
+    int16_t vx;  /* Ground speed north; unit: cm/s; range -32768..32767 */
+    int16_t vy;  /* Ground speed east; unit: cm/s; range -32768..32767 */
+    int16_t vz;  /* Ground speed down; unit: cm/s; range -32768..32767 */
+    uint16_t hdg;  /* Heading (yaw) 0..35999; 65535 when not known; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_global_position_int_response_t;
@@ -360,10 +360,10 @@ typedef struct {
     float param5;  /* Parameter 5. */
     float param6;  /* Parameter 6. */
     float param7;  /* Parameter 7. */
-    uint16_t command;  /* The command.; range 0..65535; enum mav_cmd */
-    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system).; range 0..255 */
-    uint8_t target_component;  /* Component id of the component the message is for (0 for every component).; range 0..255 */
-    uint8_t confirmation;  /* 0 the first time; one more for each retransmission.; range 0..255 */
+    uint16_t command;  /* The command; range 0..65535; enum mav_cmd */
+    uint8_t target_system;  /* System id of the vehicle the message is for (0 for every system); range 0..255 */
+    uint8_t target_component;  /* Component id of the component the message is for (0 for every component); range 0..255 */
+    uint8_t confirmation;  /* 0 the first time; one more for each retransmission; range 0..255 */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_command_long_request_t;
@@ -373,12 +373,12 @@ typedef struct {
     uint8_t seq;  /* frame seq */
     uint8_t sysid;  /* frame sysid */
     uint8_t compid;  /* frame compid */
-    uint16_t command;  /* The command acknowledged.; range 0..65535; enum mav_cmd */
-    uint8_t result;  /* Whether the command was carried out.; range 0..255; enum mav_result */
-    uint8_t progress;  /* Extension: progress in % while the result is in progress (255: unknown).; range 0..255 */
-    int32_t result_param2;  /* Extension: command-specific detail of a refusal.; range -2.14748e+09..2.14748e+09 */
-    uint8_t target_system;  /* Extension: system id of the sender of the command acknowledged.; range 0..255 */
-    uint8_t target_component;  /* Extension: component id of the sender of the command acknowledged.; range 0..255 */
+    uint16_t command;  /* The command acknowledged; range 0..65535; enum mav_cmd */
+    uint8_t result;  /* Whether the command was carried out; range 0..255; enum mav_result */
+    uint8_t progress;  /* Extension: progress in % while the result is in progress (255: unknown); range 0..255 */
+    int32_t result_param2;  /* Extension: command-specific detail of a refusal; range -2.14748e+09..2.14748e+09 */
+    uint8_t target_system;  /* Extension: system id of the sender of the command acknowledged; range 0..255 */
+    uint8_t target_component;  /* Extension: component id of the sender of the command acknowledged; range 0..255 */
     bool has_signature;  /* signature sent (encode: send it) */
     uint8_t signature[13];  /* frame signature: its bytes, when has_signature */
 } mavlink_common_command_ack_response_t;

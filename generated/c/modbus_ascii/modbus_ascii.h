@@ -153,8 +153,8 @@ typedef enum {
 /* Read Coils (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of coils.; range 1..2000 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of coils; range 1..2000 */
 } modbus_ascii_read_coils_request_t;
 
 /* Read Coils (response).  */
@@ -167,8 +167,8 @@ typedef struct {
 /* Read Discrete Inputs (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of inputs.; range 1..2000 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of inputs; range 1..2000 */
 } modbus_ascii_read_discrete_inputs_request_t;
 
 /* Read Discrete Inputs (response).  */
@@ -181,8 +181,8 @@ typedef struct {
 /* Read Holding Registers (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of registers.; range 1..125 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of registers; range 1..125 */
 } modbus_ascii_read_holding_registers_request_t;
 
 /* Read Holding Registers (response).  */
@@ -195,8 +195,8 @@ typedef struct {
 /* Read Input Registers (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of input registers.; range 1..125 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of input registers; range 1..125 */
 } modbus_ascii_read_input_registers_request_t;
 
 /* Read Input Registers (response).  */
@@ -209,35 +209,35 @@ typedef struct {
 /* Write Single Coil (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t value;  /* FF 00: ON, 00 00: OFF.; range 0..65280; enum coil_state */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t value;  /* FF 00: ON, 00 00: OFF; range 0..65280; enum coil_state */
 } modbus_ascii_write_coil_request_t;
 
 /* Write Single Coil (response).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t value;  /* The value written.; range 0..65280; enum coil_state */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t value;  /* The value written; range 0..65280; enum coil_state */
 } modbus_ascii_write_coil_response_t;
 
 /* Write Single Register (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t value;  /* The value to write.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t value;  /* The value to write; range 0..65535 */
 } modbus_ascii_write_register_request_t;
 
 /* Write Single Register (response).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t value;  /* The value written.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t value;  /* The value written; range 0..65535 */
 } modbus_ascii_write_register_response_t;
 
 /* Write Multiple Coils (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
     uint8_t values[MODBUS_ASCII_WRITE_COILS_REQUEST_VALUES_MAX];  /* The coil values, 8 per byte, lowest bit first; the last byte padded with zeros.; bits, 8 to a byte */
     size_t values_count;  /* bits in values */
 } modbus_ascii_write_coils_request_t;
@@ -245,14 +245,14 @@ typedef struct {
 /* Write Multiple Coils (response).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of outputs written.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of outputs written; range 0..65535 */
 } modbus_ascii_write_coils_response_t;
 
 /* Write Multiple Registers (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
     uint16_t values[MODBUS_ASCII_WRITE_REGISTERS_REQUEST_VALUES_MAX];  /* The register values. */
     size_t values_count;  /* items in values */
 } modbus_ascii_write_registers_request_t;
@@ -260,32 +260,32 @@ typedef struct {
 /* Write Multiple Registers (response).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t count;  /* Quantity of registers written.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t count;  /* Quantity of registers written; range 0..65535 */
 } modbus_ascii_write_registers_response_t;
 
 /* Mask Write Register (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t and_mask;  /* Bits kept from the current value.; range 0..65535 */
-    uint16_t or_mask;  /* Bits set where and_mask is 0.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t and_mask;  /* Bits kept from the current value; range 0..65535 */
+    uint16_t or_mask;  /* Bits set where and_mask is 0; range 0..65535 */
 } modbus_ascii_mask_write_register_request_t;
 
 /* Mask Write Register (response).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model).; range 0..65535 */
-    uint16_t and_mask;  /* The AND mask.; range 0..65535 */
-    uint16_t or_mask;  /* The OR mask.; range 0..65535 */
+    uint16_t address;  /* Address of the first item (0x0000..0xFFFF; "item N" is address N-1 in the data model); range 0..65535 */
+    uint16_t and_mask;  /* The AND mask; range 0..65535 */
+    uint16_t or_mask;  /* The OR mask; range 0..65535 */
 } modbus_ascii_mask_write_register_response_t;
 
 /* Read/Write Multiple Registers (request).  */
 typedef struct {
     uint8_t unit;  /* frame unit */
-    uint16_t read_address;  /* First register to read.; range 0..65535 */
-    uint16_t read_count;  /* Quantity of registers to read.; range 1..125 */
-    uint16_t write_address;  /* First register to write.; range 0..65535 */
+    uint16_t read_address;  /* First register to read; range 0..65535 */
+    uint16_t read_count;  /* Quantity of registers to read; range 1..125 */
+    uint16_t write_address;  /* First register to write; range 0..65535 */
     uint16_t values[MODBUS_ASCII_READ_WRITE_REGISTERS_REQUEST_VALUES_MAX];  /* The values to write. */
     size_t values_count;  /* items in values */
 } modbus_ascii_read_write_registers_request_t;
@@ -301,7 +301,7 @@ typedef struct {
 typedef struct {
     uint8_t unit;  /* frame unit */
     uint8_t function;  /* the code of the request refused */
-    uint8_t exception_code;  /* Why the request was refused.; range 1..11; enum exception_code */
+    uint8_t exception_code;  /* Why the request was refused; range 1..11; enum exception_code */
 } modbus_ascii_exception_response_t;
 
 /* A message: which one (kind) and its fields. */

@@ -147,7 +147,7 @@ typedef enum {
 /* Drive forward M1 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint8_t speed;  /* 0 stops the motor, 127 is full speed.; range 0..127 */
+    uint8_t speed;  /* 0 stops the motor, 127 is full speed; range 0..127 */
 } roboclaw_drive_forward_m1_request_t;
 
 /* Drive forward M1 (response).  */
@@ -158,7 +158,7 @@ typedef struct {
 /* Drive backward M1 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint8_t speed;  /* 0 stops the motor, 127 is full speed.; range 0..127 */
+    uint8_t speed;  /* 0 stops the motor, 127 is full speed; range 0..127 */
 } roboclaw_drive_backward_m1_request_t;
 
 /* Drive backward M1 (response).  */
@@ -169,7 +169,7 @@ typedef struct {
 /* Drive forward M2 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint8_t speed;  /* 0 stops the motor, 127 is full speed.; range 0..127 */
+    uint8_t speed;  /* 0 stops the motor, 127 is full speed; range 0..127 */
 } roboclaw_drive_forward_m2_request_t;
 
 /* Drive forward M2 (response).  */
@@ -180,7 +180,7 @@ typedef struct {
 /* Drive backward M2 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint8_t speed;  /* 0 stops the motor, 127 is full speed.; range 0..127 */
+    uint8_t speed;  /* 0 stops the motor, 127 is full speed; range 0..127 */
 } roboclaw_drive_backward_m2_request_t;
 
 /* Drive backward M2 (response).  */
@@ -195,8 +195,8 @@ typedef struct {
 
 /* Read encoder count M1 (response).  */
 typedef struct {
-    uint32_t count;  /* The encoder count (raw 32 bits).; range 0..4.29497e+09 */
-    uint8_t status;  /* Bit 0: underflow, bit 1: direction (1 backward), bit 2: overflow.; range 0..255 */
+    uint32_t count;  /* The encoder count (raw 32 bits); range 0..4.29497e+09 */
+    uint8_t status;  /* Bit 0: underflow, bit 1: direction (1 backward), bit 2: overflow; range 0..255 */
 } roboclaw_read_encoder_m1_response_t;
 
 /* Read encoder count M2 (request).  */
@@ -206,8 +206,8 @@ typedef struct {
 
 /* Read encoder count M2 (response).  */
 typedef struct {
-    uint32_t count;  /* The encoder count (raw 32 bits).; range 0..4.29497e+09 */
-    uint8_t status;  /* Bit 0: underflow, bit 1: direction (1 backward), bit 2: overflow.; range 0..255 */
+    uint32_t count;  /* The encoder count (raw 32 bits); range 0..4.29497e+09 */
+    uint8_t status;  /* Bit 0: underflow, bit 1: direction (1 backward), bit 2: overflow; range 0..255 */
 } roboclaw_read_encoder_m2_response_t;
 
 /* Read encoder speed M1 (request).  */
@@ -217,8 +217,8 @@ typedef struct {
 
 /* Read encoder speed M1 (response).  */
 typedef struct {
-    uint32_t speed;  /* Speed in pulses per second (magnitude).; unit: qpps; range 0..4.29497e+09 */
-    uint8_t direction;  /* 0 forward, 1 backward.; range 0..1 */
+    uint32_t speed;  /* Speed in pulses per second (magnitude); unit: qpps; range 0..4.29497e+09 */
+    uint8_t direction;  /* 0 forward, 1 backward; range 0..1 */
 } roboclaw_read_speed_m1_response_t;
 
 /* Read encoder speed M2 (request).  */
@@ -228,8 +228,8 @@ typedef struct {
 
 /* Read encoder speed M2 (response).  */
 typedef struct {
-    uint32_t speed;  /* Speed in pulses per second (magnitude).; unit: qpps; range 0..4.29497e+09 */
-    uint8_t direction;  /* 0 forward, 1 backward.; range 0..1 */
+    uint32_t speed;  /* Speed in pulses per second (magnitude); unit: qpps; range 0..4.29497e+09 */
+    uint8_t direction;  /* 0 forward, 1 backward; range 0..1 */
 } roboclaw_read_speed_m2_response_t;
 
 /* Reset both encoder counts (request).  */
@@ -260,7 +260,7 @@ typedef struct {
 
 /* Read main battery voltage (response).  */
 typedef struct {
-    uint16_t voltage;  /* Main battery voltage in 0.1 V.; unit: V; scale: 0.1 per unit; range 0..65535 */
+    uint16_t voltage;  /* Main battery voltage in 0.1 V; unit: V; scale: 0.1 per unit; range 0..65535 */
 } roboclaw_read_main_battery_response_t;
 
 /* Read logic battery voltage (request).  */
@@ -270,16 +270,16 @@ typedef struct {
 
 /* Read logic battery voltage (response).  */
 typedef struct {
-    uint16_t voltage;  /* Logic battery voltage in 0.1 V.; unit: V; scale: 0.1 per unit; range 0..65535 */
+    uint16_t voltage;  /* Logic battery voltage in 0.1 V; unit: V; scale: 0.1 per unit; range 0..65535 */
 } roboclaw_read_logic_battery_response_t;
 
 /* Set velocity PID constants M1 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t qpps;  /* The encoder's speed at full power.; unit: qpps; range 0..4.29497e+09 */
+    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t qpps;  /* The encoder's speed at full power; unit: qpps; range 0..4.29497e+09 */
 } roboclaw_set_velocity_pid_m1_request_t;
 
 /* Set velocity PID constants M1 (response).  */
@@ -290,10 +290,10 @@ typedef struct {
 /* Set velocity PID constants M2 (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t qpps;  /* The encoder's speed at full power.; unit: qpps; range 0..4.29497e+09 */
+    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t qpps;  /* The encoder's speed at full power; unit: qpps; range 0..4.29497e+09 */
 } roboclaw_set_velocity_pid_m2_request_t;
 
 /* Set velocity PID constants M2 (response).  */
@@ -304,7 +304,7 @@ typedef struct {
 /* Drive M1 with a signed duty cycle (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward).; range -32767..32767 */
+    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward); range -32767..32767 */
 } roboclaw_duty_m1_request_t;
 
 /* Drive M1 with a signed duty cycle (response).  */
@@ -315,7 +315,7 @@ typedef struct {
 /* Drive M2 with a signed duty cycle (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward).; range -32767..32767 */
+    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward); range -32767..32767 */
 } roboclaw_duty_m2_request_t;
 
 /* Drive M2 with a signed duty cycle (response).  */
@@ -326,7 +326,7 @@ typedef struct {
 /* Drive M1 with a signed speed (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int32_t speed;  /* Speed in encoder quadrature pulses per second (signed).; unit: qpps; range -2.14748e+09..2.14748e+09 */
+    int32_t speed;  /* Speed in encoder quadrature pulses per second (signed); unit: qpps; range -2.14748e+09..2.14748e+09 */
 } roboclaw_speed_m1_request_t;
 
 /* Drive M1 with a signed speed (response).  */
@@ -337,7 +337,7 @@ typedef struct {
 /* Drive M2 with a signed speed (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int32_t speed;  /* Speed in encoder quadrature pulses per second (signed).; unit: qpps; range -2.14748e+09..2.14748e+09 */
+    int32_t speed;  /* Speed in encoder quadrature pulses per second (signed); unit: qpps; range -2.14748e+09..2.14748e+09 */
 } roboclaw_speed_m2_request_t;
 
 /* Drive M2 with a signed speed (response).  */
@@ -348,8 +348,8 @@ typedef struct {
 /* Drive M1 with a duty cycle and an acceleration (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward).; range -32767..32767 */
-    uint32_t accel;  /* Acceleration: duty change per second (0: at once).; unit: 1/s; range 0..4.29497e+09 */
+    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward); range -32767..32767 */
+    uint32_t accel;  /* Acceleration: duty change per second (0: at once); unit: 1/s; range 0..4.29497e+09 */
 } roboclaw_duty_accel_m1_request_t;
 
 /* Drive M1 with a duty cycle and an acceleration (response).  */
@@ -360,8 +360,8 @@ typedef struct {
 /* Drive M2 with a duty cycle and an acceleration (request).  */
 typedef struct {
     uint8_t address;  /* frame address */
-    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward).; range -32767..32767 */
-    uint32_t accel;  /* Acceleration: duty change per second (0: at once).; unit: 1/s; range 0..4.29497e+09 */
+    int16_t duty;  /* Duty cycle: -32767 (full reverse) .. +32767 (full forward); range -32767..32767 */
+    uint32_t accel;  /* Acceleration: duty change per second (0: at once); unit: 1/s; range 0..4.29497e+09 */
 } roboclaw_duty_accel_m2_request_t;
 
 /* Drive M2 with a duty cycle and an acceleration (response).  */
@@ -376,10 +376,10 @@ typedef struct {
 
 /* Read velocity PID constants M1 (response).  */
 typedef struct {
-    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t qpps;  /* The encoder's speed at full power.; unit: qpps; range 0..4.29497e+09 */
+    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t qpps;  /* The encoder's speed at full power; unit: qpps; range 0..4.29497e+09 */
 } roboclaw_read_velocity_pid_m1_response_t;
 
 /* Read velocity PID constants M2 (request).  */
@@ -389,10 +389,10 @@ typedef struct {
 
 /* Read velocity PID constants M2 (response).  */
 typedef struct {
-    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536).; range 0..4.29497e+09 */
-    uint32_t qpps;  /* The encoder's speed at full power.; unit: qpps; range 0..4.29497e+09 */
+    uint32_t p;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t i;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t d;  /* A PID gain as 16.16 fixed point (gain × 65536); range 0..4.29497e+09 */
+    uint32_t qpps;  /* The encoder's speed at full power; unit: qpps; range 0..4.29497e+09 */
 } roboclaw_read_velocity_pid_m2_response_t;
 
 /* Read error and warning status (request).  */
@@ -402,7 +402,7 @@ typedef struct {
 
 /* Read error and warning status (response).  */
 typedef struct {
-    uint32_t status;  /* Errors in the low 16 bits, warnings in the high 16 bits (0: none).; range 0..4.29497e+09 */
+    uint32_t status;  /* Errors in the low 16 bits, warnings in the high 16 bits (0: none); range 0..4.29497e+09 */
 } roboclaw_read_error_response_t;
 
 /* A message: which one (kind) and its fields. */

@@ -160,13 +160,13 @@ typedef struct {
 
 /* NAV-STATUS, receiver navigation status (response).  */
 typedef struct {
-    uint32_t itow;  /* GPS time of week of the navigation epoch, in ms (the epoch's tag; not the precise time of the fix).; unit: ms; range 0..4.29497e+09 */
-    uint8_t gps_fix;  /* The fix type.; range 0..5; enum fix_type */
-    uint8_t status_flags;  /* Navigation status flags (u-blox's `flags`; named apart from NAV-PVT's, see the device's description).; range 0..255; bits gps_fix_ok [0:0], diff_soln [1:1], wkn_set [2:2], tow_set [3:3] */
-    uint8_t fix_stat;  /* Fix status information.; range 0..255; bits diff_corr [0:0], carr_soln_valid [1:1], reserved0 [5:2], map_matching [7:6] */
-    uint8_t status_flags2;  /* Further status (u-blox's `flags2`).; range 0..255; bits psm_state [1:0], reserved1 [2:2], spoof_det_state [4:3], reserved2 [5:5], carr_soln [7:6] */
-    uint32_t ttff;  /* Time to first fix.; unit: ms; range 0..4.29497e+09 */
-    uint32_t msss;  /* Milliseconds since startup or reset.; unit: ms; range 0..4.29497e+09 */
+    uint32_t itow;  /* GPS time of week of the navigation epoch, in ms (the epoch's tag; not the precise time of the fix); unit: ms; range 0..4.29497e+09 */
+    uint8_t gps_fix;  /* The fix type; range 0..5; enum fix_type */
+    uint8_t status_flags;  /* Navigation status flags (u-blox's `flags`; named apart from NAV-PVT's, see the device's description); range 0..255; bits gps_fix_ok [0:0], diff_soln [1:1], wkn_set [2:2], tow_set [3:3] */
+    uint8_t fix_stat;  /* Fix status information; range 0..255; bits diff_corr [0:0], carr_soln_valid [1:1], reserved0 [5:2], map_matching [7:6] */
+    uint8_t status_flags2;  /* Further status (u-blox's `flags2`); range 0..255; bits psm_state [1:0], reserved1 [2:2], spoof_det_state [4:3], reserved2 [5:5], carr_soln [7:6] */
+    uint32_t ttff;  /* Time to first fix; unit: ms; range 0..4.29497e+09 */
+    uint32_t msss;  /* Milliseconds since startup or reset; unit: ms; range 0..4.29497e+09 */
 } ubx_nav_status_response_t;
 
 /* NAV-PVT, navigation position velocity time solution (request). The poll (an empty payload). */
@@ -176,49 +176,49 @@ typedef struct {
 
 /* NAV-PVT, navigation position velocity time solution (response).  */
 typedef struct {
-    uint32_t itow;  /* GPS time of week of the navigation epoch, in ms (the epoch's tag; not the precise time of the fix).; unit: ms; range 0..4.29497e+09 */
-    uint16_t year;  /* Year (UTC).; range 0..65535 */
-    uint8_t month;  /* Month (UTC).; range 1..12 */
-    uint8_t day;  /* Day of the month (UTC).; range 1..31 */
-    uint8_t hour;  /* Hour of the day (UTC).; range 0..23 */
-    uint8_t minute;  /* Minute (UTC).; range 0..59 */
-    uint8_t second;  /* Seconds (UTC; 60 in a leap second).; range 0..60 */
-    uint8_t valid;  /* Validity flags.; range 0..255; bits valid_date [0:0], valid_time [1:1], fully_resolved [2:2], valid_mag [3:3] */
-    uint32_t t_acc;  /* Time accuracy estimate (UTC).; unit: ns; range 0..4.29497e+09 */
-    int32_t nano;  /* Fraction of a second (UTC), -1e9..1e9.; unit: ns; range -1e+09..1e+09 */
-    uint8_t fix_type;  /* The fix type.; range 0..5; enum fix_type */
-    uint8_t flags;  /* Fix status flags.; range 0..255; bits gnss_fix_ok [0:0], diff_soln [1:1], psm_state [4:2], head_veh_valid [5:5], carr_soln [7:6] */
-    uint8_t flags2;  /* Further time validity flags.; range 0..255; bits reserved [4:0], confirmed_avai [5:5], confirmed_date [6:6], confirmed_time [7:7] */
-    uint8_t num_sv;  /* Satellites used in the solution.; range 0..255 */
-    int32_t lon;  /* Longitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t lat;  /* Latitude in degrees × 10^7.; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t height;  /* Height above the ellipsoid.; unit: mm; range -2.14748e+09..2.14748e+09 */
-    int32_t h_msl;  /* Height above mean sea level.; unit: mm; range -2.14748e+09..2.14748e+09 */
-    uint32_t h_acc;  /* Horizontal accuracy estimate.; unit: mm; range 0..4.29497e+09 */
-    uint32_t v_acc;  /* Vertical accuracy estimate.; unit: mm; range 0..4.29497e+09 */
-    int32_t vel_n;  /* NED north velocity.; unit: mm/s; range -2.14748e+09..2.14748e+09 */
-    int32_t vel_e;  /* NED east velocity.; unit: mm/s; range -2.14748e+09..2.14748e+09 */
-    int32_t vel_d;  /* NED down velocity.; unit: mm/s; range -2.14748e+09..2.14748e+09 */
-    int32_t g_speed;  /* Ground speed (2D).; unit: mm/s; range -2.14748e+09..2.14748e+09 */
-    int32_t head_mot;  /* Heading of motion (2D) in degrees × 10^5.; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
-    uint32_t s_acc;  /* Speed accuracy estimate.; unit: mm/s; range 0..4.29497e+09 */
-    uint32_t head_acc;  /* Heading accuracy estimate (motion and vehicle) in degrees × 10^5.; unit: 0.00001°; scale: 1e-05 per unit; range 0..4.29497e+09 */
-    uint16_t p_dop;  /* Position DOP × 100.; unit: 0.01; scale: 0.01 per unit; range 0..65535 */
-    uint16_t flags3;  /* Further flags.; range 0..65535; bits invalid_llh [0:0], last_correction_age [4:1], reserved1 [12:5], auth_time [13:13], nma_fix_status [14:14] */
-    uint32_t reserved0;  /* Reserved (4 bytes).; range 0..4.29497e+09 */
-    int32_t head_veh;  /* Heading of the vehicle (2D) in degrees × 10^5; valid only when head_veh_valid is set.; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
-    int16_t mag_dec;  /* Magnetic declination in degrees × 100 (ADR and UDR products only).; unit: 0.01°; scale: 0.01 per unit; range -32768..32767 */
-    uint16_t mag_acc;  /* Magnetic declination accuracy in degrees × 100.; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
+    uint32_t itow;  /* GPS time of week of the navigation epoch, in ms (the epoch's tag; not the precise time of the fix); unit: ms; range 0..4.29497e+09 */
+    uint16_t year;  /* Year (UTC); range 0..65535 */
+    uint8_t month;  /* Month (UTC); range 1..12 */
+    uint8_t day;  /* Day of the month (UTC); range 1..31 */
+    uint8_t hour;  /* Hour of the day (UTC); range 0..23 */
+    uint8_t minute;  /* Minute (UTC); range 0..59 */
+    uint8_t second;  /* Seconds (UTC; 60 in a leap second); range 0..60 */
+    uint8_t valid;  /* Validity flags; range 0..255; bits valid_date [0:0], valid_time [1:1], fully_resolved [2:2], valid_mag [3:3] */
+    uint32_t t_acc;  /* Time accuracy estimate (UTC); unit: ns; range 0..4.29497e+09 */
+    int32_t nano;  /* Fraction of a second (UTC), -1e9..1e9; unit: ns; range -1e+09..1e+09 */
+    uint8_t fix_type;  /* The fix type; range 0..5; enum fix_type */
+    uint8_t flags;  /* Fix status flags; range 0..255; bits gnss_fix_ok [0:0], diff_soln [1:1], psm_state [4:2], head_veh_valid [5:5], carr_soln [7:6] */
+    uint8_t flags2;  /* Further time validity flags; range 0..255; bits reserved [4:0], confirmed_avai [5:5], confirmed_date [6:6], confirmed_time [7:7] */
+    uint8_t num_sv;  /* Satellites used in the solution; range 0..255 */
+    int32_t lon;  /* Longitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t lat;  /* Latitude in degrees × 10^7; unit: 0.0000001°; scale: 1e-07 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t height;  /* Height above the ellipsoid; unit: mm; range -2.14748e+09..2.14748e+09 */
+    int32_t h_msl;  /* Height above mean sea level; unit: mm; range -2.14748e+09..2.14748e+09 */
+    uint32_t h_acc;  /* Horizontal accuracy estimate; unit: mm; range 0..4.29497e+09 */
+    uint32_t v_acc;  /* Vertical accuracy estimate; unit: mm; range 0..4.29497e+09 */
+    int32_t vel_n;  /* NED north velocity; unit: mm/s; range -2.14748e+09..2.14748e+09 */
+    int32_t vel_e;  /* NED east velocity; unit: mm/s; range -2.14748e+09..2.14748e+09 */
+    int32_t vel_d;  /* NED down velocity; unit: mm/s; range -2.14748e+09..2.14748e+09 */
+    int32_t g_speed;  /* Ground speed (2D); unit: mm/s; range -2.14748e+09..2.14748e+09 */
+    int32_t head_mot;  /* Heading of motion (2D) in degrees × 10^5; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
+    uint32_t s_acc;  /* Speed accuracy estimate; unit: mm/s; range 0..4.29497e+09 */
+    uint32_t head_acc;  /* Heading accuracy estimate (motion and vehicle) in degrees × 10^5; unit: 0.00001°; scale: 1e-05 per unit; range 0..4.29497e+09 */
+    uint16_t p_dop;  /* Position DOP × 100; unit: 0.01; scale: 0.01 per unit; range 0..65535 */
+    uint16_t flags3;  /* Further flags; range 0..65535; bits invalid_llh [0:0], last_correction_age [4:1], reserved1 [12:5], auth_time [13:13], nma_fix_status [14:14] */
+    uint32_t reserved0;  /* Reserved (4 bytes); range 0..4.29497e+09 */
+    int32_t head_veh;  /* Heading of the vehicle (2D) in degrees × 10^5; valid only when head_veh_valid is set; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
+    int16_t mag_dec;  /* Magnetic declination in degrees × 100 (ADR and UDR products only); unit: 0.01°; scale: 0.01 per unit; range -32768..32767 */
+    uint16_t mag_acc;  /* Magnetic declination accuracy in degrees × 100; unit: 0.01°; scale: 0.01 per unit; range 0..65535 */
 } ubx_nav_pvt_response_t;
 
 /* ACK-NAK, message not acknowledged (response).  */
 typedef struct {
-    uint16_t refused;  /* The refused message's class (high byte) and id (low byte), as the command element reads them: 0x0608 for CFG-RATE.; range 0..65535 */
+    uint16_t refused;  /* The refused message's class (high byte) and id (low byte), as the command element reads them: 0x0608 for CFG-RATE; range 0..65535 */
 } ubx_ack_nak_response_t;
 
 /* ACK-ACK, message acknowledged (response).  */
 typedef struct {
-    uint16_t acked;  /* The acknowledged message's class (high byte) and id (low byte), as the command element reads them: 0x0608 for CFG-RATE.; range 0..65535 */
+    uint16_t acked;  /* The acknowledged message's class (high byte) and id (low byte), as the command element reads them: 0x0608 for CFG-RATE; range 0..65535 */
 } ubx_ack_ack_response_t;
 
 /* CFG-RATE, navigation and measurement rate (poll) (request). The poll (an empty payload). */
@@ -228,40 +228,40 @@ typedef struct {
 
 /* CFG-RATE, navigation and measurement rate (poll) (response).  */
 typedef struct {
-    uint16_t meas_rate;  /* The time between GNSS measurements (1000: 1 Hz; at least 25).; unit: ms; range 25..65535 */
-    uint16_t nav_rate;  /* Measurements for each navigation solution (at most 127; 1 on generation 9 and later).; unit: cycles; range 1..127 */
-    uint16_t time_ref;  /* The time system measurements are aligned to.; range 0..5; enum time_reference */
+    uint16_t meas_rate;  /* The time between GNSS measurements (1000: 1 Hz; at least 25); unit: ms; range 25..65535 */
+    uint16_t nav_rate;  /* Measurements for each navigation solution (at most 127; 1 on generation 9 and later); unit: cycles; range 1..127 */
+    uint16_t time_ref;  /* The time system measurements are aligned to; range 0..5; enum time_reference */
 } ubx_cfg_rate_response_t;
 
 /* CFG-RATE, navigation and measurement rate (set) (request).  */
 typedef struct {
-    uint16_t meas_rate;  /* The time between GNSS measurements (1000: 1 Hz; at least 25).; unit: ms; range 25..65535 */
-    uint16_t nav_rate;  /* Measurements for each navigation solution (at most 127; 1 on generation 9 and later).; unit: cycles; range 1..127 */
-    uint16_t time_ref;  /* The time system measurements are aligned to.; range 0..5; enum time_reference */
+    uint16_t meas_rate;  /* The time between GNSS measurements (1000: 1 Hz; at least 25); unit: ms; range 25..65535 */
+    uint16_t nav_rate;  /* Measurements for each navigation solution (at most 127; 1 on generation 9 and later); unit: cycles; range 1..127 */
+    uint16_t time_ref;  /* The time system measurements are aligned to; range 0..5; enum time_reference */
 } ubx_set_rate_request_t;
 
 /* CFG-VALSET, set configuration items (request).  */
 typedef struct {
-    uint8_t version;  /* 0: no transaction; 1: with a transaction (the transaction byte counts).; range 0..1 */
-    uint8_t layers;  /* The layers the items are written to.; range 0..255; bits ram [0:0], bbr [1:1], flash [2:2] */
-    uint8_t transaction;  /* Version 1 only (0 otherwise).; range 0..255; bits action [1:0] */
-    uint8_t reserved0;  /* Reserved.; range 0..255 */
+    uint8_t version;  /* 0: no transaction; 1: with a transaction (the transaction byte counts); range 0..1 */
+    uint8_t layers;  /* The layers the items are written to; range 0..255; bits ram [0:0], bbr [1:1], flash [2:2] */
+    uint8_t transaction;  /* Version 1 only (0 otherwise); range 0..255; bits action [1:0] */
+    uint8_t reserved0;  /* Reserved; range 0..255 */
     uint8_t cfg_data[UBX_CFG_VALSET_REQUEST_CFG_DATA_MAX];  /* The items: each a u32 key ID (little-endian) and its value (1, 1, 2, 4 or 8 bytes, little-endian, as the key's bits 28..30 say: 1 bit, 1, 2, 4, 8 bytes). */
     size_t cfg_data_len;  /* bytes in cfg_data */
 } ubx_cfg_valset_request_t;
 
 /* CFG-VALGET, get configuration items (request).  */
 typedef struct {
-    uint8_t layer;  /* The layer read.; range 0..7; enum layer */
-    uint16_t position;  /* Skip this many key-value pairs of the result (for results over 64 items).; range 0..65535 */
+    uint8_t layer;  /* The layer read; range 0..7; enum layer */
+    uint16_t position;  /* Skip this many key-value pairs of the result (for results over 64 items); range 0..65535 */
     uint32_t keys[UBX_CFG_VALGET_REQUEST_KEYS_MAX];  /* The key IDs (at most 64). */
     size_t keys_count;  /* items in keys */
 } ubx_cfg_valget_request_t;
 
 /* CFG-VALGET, get configuration items (response).  */
 typedef struct {
-    uint8_t layer;  /* The layer read.; range 0..7; enum layer */
-    uint16_t position;  /* The number of key-value pairs skipped (the request's position).; range 0..65535 */
+    uint8_t layer;  /* The layer read; range 0..7; enum layer */
+    uint16_t position;  /* The number of key-value pairs skipped (the request's position); range 0..65535 */
     uint8_t cfg_data[UBX_CFG_VALGET_RESPONSE_CFG_DATA_MAX];  /* The items: each a u32 key ID (little-endian) and its value (1, 1, 2, 4 or 8 bytes, as the key's bits 28..30 say). */
     size_t cfg_data_len;  /* bytes in cfg_data */
 } ubx_cfg_valget_response_t;

@@ -166,22 +166,22 @@ typedef struct {
 
 /* COMM_FW_VERSION (response).  */
 typedef struct {
-    uint8_t major;  /* Firmware major version.; range 0..255 */
-    uint8_t minor;  /* Firmware minor version.; range 0..255 */
+    uint8_t major;  /* Firmware major version; range 0..255 */
+    uint8_t minor;  /* Firmware minor version; range 0..255 */
     char hw_name[VESC_FW_VERSION_RESPONSE_HW_NAME_MAX + 1u];  /* Hardware name (HW_NAME), NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t hw_name_len;  /* bytes of text in hw_name */
     uint8_t uuid[12];  /* The STM32's 96-bit unique id (plus 1 for a second motor). */
-    uint8_t pairing_done;  /* 1 once NRF pairing is done.; range 0..255 */
-    uint8_t test_version;  /* Test build number (FW_TEST_VERSION_NUMBER); 0 for a release.; range 0..255 */
-    uint8_t hw_type;  /* The kind of hardware.; range 0..2; enum hw_type */
-    uint8_t custom_config_count;  /* Number of custom configurations.; range 0..255 */
-    uint8_t phase_filters;  /* 1 if the hardware has phase filters.; range 0..255 */
-    uint8_t qml_hw;  /* QML UI from the hardware: 0 none, 1 yes, 2 fullscreen.; range 0..255 */
-    uint8_t qml_app;  /* QML UI from the app: 0 none, else its flags.; range 0..255 */
-    uint8_t nrf_flags;  /* NRF radio flags.; range 0..255 */
+    uint8_t pairing_done;  /* 1 once NRF pairing is done; range 0..255 */
+    uint8_t test_version;  /* Test build number (FW_TEST_VERSION_NUMBER); 0 for a release; range 0..255 */
+    uint8_t hw_type;  /* The kind of hardware; range 0..2; enum hw_type */
+    uint8_t custom_config_count;  /* Number of custom configurations; range 0..255 */
+    uint8_t phase_filters;  /* 1 if the hardware has phase filters; range 0..255 */
+    uint8_t qml_hw;  /* QML UI from the hardware: 0 none, 1 yes, 2 fullscreen; range 0..255 */
+    uint8_t qml_app;  /* QML UI from the app: 0 none, else its flags; range 0..255 */
+    uint8_t nrf_flags;  /* NRF radio flags; range 0..255 */
     char fw_name[VESC_FW_VERSION_RESPONSE_FW_NAME_MAX + 1u];  /* Firmware name (FW_NAME), NUL-terminated. (in C: UTF-8, NUL-terminated) */
     size_t fw_name_len;  /* bytes of text in fw_name */
-    uint32_t hw_crc;  /* CRC of the hardware configuration (main_calc_hw_crc).; range 0..4.29497e+09 */
+    uint32_t hw_crc;  /* CRC of the hardware configuration (main_calc_hw_crc); range 0..4.29497e+09 */
 } vesc_fw_version_response_t;
 
 /* COMM_GET_VALUES (request).  */
@@ -191,60 +191,60 @@ typedef struct {
 
 /* COMM_GET_VALUES (response).  */
 typedef struct {
-    int16_t temp_fet;  /* MOSFET temperature (filtered).; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
-    int16_t temp_motor;  /* Motor temperature (filtered).; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
-    int32_t avg_motor_current;  /* Average motor current since the last read.; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t avg_input_current;  /* Average input current since the last read.; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t avg_id;  /* Average d-axis current.; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t avg_iq;  /* Average q-axis current.; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
-    int16_t duty_now;  /* Duty cycle now (-1..1).; unit: 0.001; scale: 0.001 per unit; range -32768..32767 */
-    int32_t rpm;  /* Electrical rpm (mechanical rpm × pole pairs).; unit: ERPM; range -2.14748e+09..2.14748e+09 */
-    int16_t v_in;  /* Input voltage (filtered).; unit: 0.1 V; scale: 0.1 per unit; range -32768..32767 */
-    int32_t amp_hours;  /* Charge drawn.; unit: 0.0001 Ah; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t amp_hours_charged;  /* Charge regenerated.; unit: 0.0001 Ah; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t watt_hours;  /* Energy drawn.; unit: 0.0001 Wh; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t watt_hours_charged;  /* Energy regenerated.; unit: 0.0001 Wh; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t tachometer;  /* Tachometer (6 counts per electrical revolution, signed).; range -2.14748e+09..2.14748e+09 */
-    int32_t tachometer_abs;  /* Absolute tachometer.; range -2.14748e+09..2.14748e+09 */
-    uint8_t fault;  /* The present fault.; range 0..33; enum fault_code */
-    int32_t pid_pos;  /* Position of the position controller.; unit: 0.000001°; scale: 1e-06 per unit; range -2.14748e+09..2.14748e+09 */
-    uint8_t controller_id;  /* The controller's CAN id.; range 0..255 */
-    int16_t temp_mos1;  /* MOSFET 1 temperature.; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
-    int16_t temp_mos2;  /* MOSFET 2 temperature.; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
-    int16_t temp_mos3;  /* MOSFET 3 temperature.; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
-    int32_t avg_vd;  /* Average d-axis voltage.; unit: 0.001 V; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
-    int32_t avg_vq;  /* Average q-axis voltage.; unit: 0.001 V; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
-    uint8_t status;  /* Timeout and kill switch state.; range 0..255 */
+    int16_t temp_fet;  /* MOSFET temperature (filtered); unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
+    int16_t temp_motor;  /* Motor temperature (filtered); unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
+    int32_t avg_motor_current;  /* Average motor current since the last read; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t avg_input_current;  /* Average input current since the last read; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t avg_id;  /* Average d-axis current; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t avg_iq;  /* Average q-axis current; unit: 0.01 A; scale: 0.01 per unit; range -2.14748e+09..2.14748e+09 */
+    int16_t duty_now;  /* Duty cycle now (-1..1); unit: 0.001; scale: 0.001 per unit; range -32768..32767 */
+    int32_t rpm;  /* Electrical rpm (mechanical rpm × pole pairs); unit: ERPM; range -2.14748e+09..2.14748e+09 */
+    int16_t v_in;  /* Input voltage (filtered); unit: 0.1 V; scale: 0.1 per unit; range -32768..32767 */
+    int32_t amp_hours;  /* Charge drawn; unit: 0.0001 Ah; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t amp_hours_charged;  /* Charge regenerated; unit: 0.0001 Ah; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t watt_hours;  /* Energy drawn; unit: 0.0001 Wh; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t watt_hours_charged;  /* Energy regenerated; unit: 0.0001 Wh; scale: 0.0001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t tachometer;  /* Tachometer (6 counts per electrical revolution, signed); range -2.14748e+09..2.14748e+09 */
+    int32_t tachometer_abs;  /* Absolute tachometer; range -2.14748e+09..2.14748e+09 */
+    uint8_t fault;  /* The present fault; range 0..33; enum fault_code */
+    int32_t pid_pos;  /* Position of the position controller; unit: 0.000001°; scale: 1e-06 per unit; range -2.14748e+09..2.14748e+09 */
+    uint8_t controller_id;  /* The controller's CAN id; range 0..255 */
+    int16_t temp_mos1;  /* MOSFET 1 temperature; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
+    int16_t temp_mos2;  /* MOSFET 2 temperature; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
+    int16_t temp_mos3;  /* MOSFET 3 temperature; unit: 0.1 °C; scale: 0.1 per unit; range -32768..32767 */
+    int32_t avg_vd;  /* Average d-axis voltage; unit: 0.001 V; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t avg_vq;  /* Average q-axis voltage; unit: 0.001 V; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
+    uint8_t status;  /* Timeout and kill switch state; range 0..255 */
 } vesc_get_values_response_t;
 
 /* COMM_SET_DUTY (request).  */
 typedef struct {
-    int32_t duty;  /* Duty cycle × 100000.; unit: 0.00001; scale: 1e-05 per unit; range -100000..100000 */
+    int32_t duty;  /* Duty cycle × 100000; unit: 0.00001; scale: 1e-05 per unit; range -100000..100000 */
 } vesc_set_duty_request_t;
 
 /* COMM_SET_CURRENT (request).  */
 typedef struct {
-    int32_t current;  /* Motor current in mA (negative brakes or reverses).; unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t current;  /* Motor current in mA (negative brakes or reverses); unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
 } vesc_set_current_request_t;
 
 /* COMM_SET_CURRENT_BRAKE (request).  */
 typedef struct {
-    int32_t current;  /* Brake current in mA.; unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t current;  /* Brake current in mA; unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
 } vesc_set_current_brake_request_t;
 
 /* COMM_SET_RPM (request).  */
 typedef struct {
-    int32_t rpm;  /* Target electrical rpm.; unit: ERPM; range -2.14748e+09..2.14748e+09 */
+    int32_t rpm;  /* Target electrical rpm; unit: ERPM; range -2.14748e+09..2.14748e+09 */
 } vesc_set_rpm_request_t;
 
 /* COMM_SET_POS (request).  */
 typedef struct {
-    int32_t position;  /* Target position × 1000000, in degrees.; unit: 0.000001°; scale: 1e-06 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t position;  /* Target position × 1000000, in degrees; unit: 0.000001°; scale: 1e-06 per unit; range -2.14748e+09..2.14748e+09 */
 } vesc_set_pos_request_t;
 
 /* COMM_SET_HANDBRAKE (request).  */
 typedef struct {
-    int32_t current;  /* Handbrake current in mA.; unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t current;  /* Handbrake current in mA; unit: mA; scale: 0.001 per unit; range -2.14748e+09..2.14748e+09 */
 } vesc_set_handbrake_request_t;
 
 /* COMM_PRINT (response).  */
@@ -255,7 +255,7 @@ typedef struct {
 
 /* COMM_ROTOR_POSITION (response).  */
 typedef struct {
-    int32_t position;  /* Rotor position × 100000, in degrees.; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
+    int32_t position;  /* Rotor position × 100000, in degrees; unit: 0.00001°; scale: 1e-05 per unit; range -2.14748e+09..2.14748e+09 */
 } vesc_rotor_position_response_t;
 
 /* COMM_ALIVE (request).  */
@@ -265,7 +265,7 @@ typedef struct {
 
 /* COMM_FORWARD_CAN (request).  */
 typedef struct {
-    uint8_t can_id;  /* CAN id of the controller to reach.; range 0..255 */
+    uint8_t can_id;  /* CAN id of the controller to reach; range 0..255 */
     uint8_t payload[VESC_FORWARD_CAN_REQUEST_PAYLOAD_MAX];  /* The forwarded payload: a command id and its fields. */
     size_t payload_len;  /* bytes in payload */
 } vesc_forward_can_request_t;

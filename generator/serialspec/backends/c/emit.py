@@ -441,6 +441,8 @@ def field_doc(f: Field) -> str:
         parts.append(f"enum {f.enum.name}")
     if isinstance(f, Scalar) and f.bits:
         parts.append("bits " + ", ".join(f"{b.name} [{b.high}:{b.low}]" for b in f.bits))
+    if f.description and len(parts) > 1:  # "First address to write; range 0..255", not "write.; range"
+        parts[0] = parts[0].removesuffix(".")
     return "; ".join(parts)
 
 

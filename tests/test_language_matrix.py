@@ -1978,6 +1978,42 @@ def test_a_reply_of_values_alone_through_every_output() -> None:
         assert both.feed(package.encode(asked) + frame) == [asked, answer]
 
 
+def test_an_answer_ended_by_another_line_through_every_output(tmp_path: Path) -> None:
+    """`answered_by: {command, then}` on a text request (an AT command's reply line, then its `OK`): every output
+    takes the spec (the C and the dissector read each line alone, as before; the C compiles clean), the reference
+    says which line ends the answer, and the simulator sends the reply and then that line."""
+    from serialspec.backends import emit
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["commands"]["ask"] = {
+        "code": "AS",
+        "title": "Asked for the dial's reply, the answer ended by OK",
+        "request": {
+            "fields": {"level": {"type": "integer", "range": [0, 99]}, "note": "text"},
+            "answered_by": {"command": "dial", "then": "answer"},
+        },
+    }
+    case["device"]["commands"]["ask"] = case["device"]["commands"]["dial"]
+    case["device"]["reply"] = {"ok": "S"}
+    protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    files: dict[str, str] = {}
+    for emitter in emitters():
+        emitted = emit(emitter, protocol)
+        if emitter.name == "c":
+            text_c_compiles(emitted, tmp_path)
+        assert emitter.verify is None or emitter.verify(protocol, emitted) == []
+        files.update(emitted)
+    assert "then the `answer` response, which ends the answer" in files["docs/matrix_text.md"]
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        assert package.CODEC.final("AS") is package.AnswerResponse and package.CODEC.final("DL") is None
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        [(_, frames)] = device.feed(package.encode(package.AskRequest(talker="A", level=7, note="hi")))
+        reply, ending = package.StreamParser("response").feed(frames)
+        assert (reply.level, reply.volts, reply.count, reply.note) == (7, 25, 8, "hi"), reply
+        assert ending == package.AnswerResponse(talker=ending.talker, ok=package.Side.SOUTH), ending
+
+
 def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
     """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value
     right after the code) beside the case's plain sentences: C and

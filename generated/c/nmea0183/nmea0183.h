@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "b50f0eceea9997d7c86f0d7ba5f980852959573886b2feb1e4e7abe07173229a"
+#define NMEA0183_SPEC_SHA256 "0ec6ace3b51997652c2f1511870f707d3bb62aa3ab4c4f5a2607f5abbca63f40"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

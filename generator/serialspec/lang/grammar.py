@@ -736,6 +736,15 @@ MESSAGE = Obj(
                     "data`, `refused_by: [write]`, whose reply is `EE status`).",
                     example=["nak"],
                 ),
+                "then": Str(
+                    "Text frames: the command whose response ends the answer, after the reply (an AT command's "
+                    "final `OK` after its `+NAME:` line; GRBL's `ok` after a `$` setting's line). The client's method "
+                    "returns the reply once this response has come too, so the next request does not take it for its "
+                    "own answer; a `refused_by` response in place of either raises DeviceError, and where the device "
+                    "ends the answer without a reply the method says so (DeviceError). The simulator sends it after "
+                    "each reply that is not a refusal.",
+                    example="ok",
+                ),
                 "optional_when": OPTIONAL_WHEN,
             },
             description="For a request: answered by another command's response (FEETECH's one status packet; in text "

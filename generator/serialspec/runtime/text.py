@@ -1126,7 +1126,7 @@ class TextCodec:
         self,
         framing: TextFraming,
         classes: Iterable[type[TextRecord]],
-        answers: Mapping[str, tuple[tuple[str, ...], tuple[str, ...]]] | None = None,
+        answers: Mapping[str, tuple[tuple[str, ...], ...]] | None = None,
     ) -> None:
         self.framing = framing
         self.classes = {(cls.CODE, cls.DIRECTION.value): cls for cls in classes}
@@ -1137,9 +1137,14 @@ class TextCodec:
 
     def replies(self, code: str) -> tuple[tuple[type[TextRecord], ...], tuple[type[TextRecord], ...]]:
         """The response classes that answer a request of this code, and those that refuse it."""
-        answering, refusing = self.answers.get(code, ((code,), ()))
+        answering, refusing = self.answers.get(code, ((code,), ()))[:2]
         responses = self._responses
         return tuple(responses[c] for c in answering if c in responses), tuple(responses[c] for c in refusing)
+
+    def final(self, code: str) -> type[TextRecord] | None:
+        """The response that ends the answer to a request of this code, after its reply (`then`), or None."""
+        ending = self.answers.get(code, ((), (), ()))[2:]  # (answers, refusals, (the final code,)): with `then`
+        return self._responses[ending[0][0]] if ending and ending[0] else None
 
     def message(self, sentence: Sentence) -> Any:
         cls = self.classes[sentence.code, sentence.direction]
@@ -1267,19 +1272,39 @@ class TextClient:
         answers, refusals = self.CODEC.replies(message.CODE)
         if not answers:
             return None  # a command the device does not answer
+        final = self.CODEC.final(message.CODE)  # the response that ends the answer, after the reply (`then`)
         self.parser.expect(self.CODEC.reply_code(message.CODE))  # a reply of values alone is read as the answer
+        answer = None
         try:
             deadline = time.monotonic() + timeout
             while (left := deadline - time.monotonic()) > 0:
                 for arrived in self._arrived((yield min(left, 0.2))):
-                    if isinstance(arrived, answers):
-                        return arrived
-                    if isinstance(arrived, refusals):
+                    if answer is None and isinstance(arrived, answers):
+                        if final is None:
+                            return arrived
+                        answer = arrived  # the answer goes on to its final response
+                        self.parser.expect(None)
+                    elif isinstance(arrived, refusals):
                         raise DeviceError(
                             f"{message.COMMAND} ({message.CODE}): the device refused it: {arrived!r}", arrived
                         )
-                    self._unread.append(arrived)
-            raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+                    elif final is not None and isinstance(arrived, final):
+                        if answer is None:
+                            raise DeviceError(
+                                f"{message.COMMAND} ({message.CODE}): the device ended its answer ({arrived!r}) "
+                                "without a reply",
+                                arrived,
+                            )
+                        return answer
+                    else:
+                        self._unread.append(arrived)
+            late = Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+            if answer is not None and final is not None:  # the reply came: say what did not
+                late.args = (
+                    f"{message.COMMAND} ({message.CODE}): its reply came, but not the {final.CODE!r} that ends the "
+                    f"answer within {timeout * 1000:.0f} ms",
+                )
+            raise late
         finally:
             self.parser.expect(None)
 

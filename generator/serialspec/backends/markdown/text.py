@@ -171,6 +171,8 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         sent = "sent by the device on its own" if message.unsolicited else f"a {message.direction.value}"
         if message.answered_by:
             sent += f", answered by the `{message.answered_by}` response"
+        if message.then:
+            sent += f", then the `{message.then}` response, which ends the answer"
         if message.refused_by:
             sent += f", refused by {' or '.join(f'the `{name}` response' for name in message.refused_by)}"
         if message.values_only:

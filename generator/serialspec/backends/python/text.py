@@ -50,6 +50,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield ""
     used = {text.message(s.command).class_name for s in device.sends}
     used |= {m.class_name for request, response, _ in answered for m in (request, response) if m is not None}
+    used |= {text.message(request.then).class_name for request, _, _ in answered if request.then}
     classes = sorted(used)
     yield f"from . import CODEC, {', '.join(['PROTOCOL', *classes])}"
     yield ""
@@ -80,6 +81,8 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
                 args.append(f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in answer.reports.items())}}}")
             if answer is not None and answer.echoes:
                 args.append(f"echoes={answer.echoes!r}")
+            if request.then:  # the response that ends each answer, after the reply
+                args.append(f"final=cast(Any, {text.message(request.then).class_name})")
             args.append(f"blanks={empty!r}")
             yield f"        CommandSpec({', '.join(args)}),"
         yield "    ),"
@@ -348,6 +351,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     answers = text.answers()
     if answers:
         yield "# requests answered by another command's response, or refused by some: code -> (answers, refusals)"
+        if any(len(entry) > 2 for entry in answers.values()):
+            yield "# and, after them, the response that ends the answer (`then`)"
         yield f"CODEC = TextCodec(FRAMING, MESSAGE_TYPES, answers={answers!r})"
     else:
         yield "CODEC = TextCodec(FRAMING, MESSAGE_TYPES)"

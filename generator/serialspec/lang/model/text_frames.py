@@ -77,6 +77,7 @@ class TextMessage:
     source: str = ""
     answered_by: str = ""  # a request answered by another command's response (its key): GRBL's `ok`
     refused_by: tuple[str, ...] = ()  # commands whose responses refuse the request instead: GRBL's `error:N`
+    then: str = ""  # a request: the command whose response ends its answer, after the reply (an AT command's `OK`)
     layout: TextLayout | None = None  # its own text inside the frame (`text:`): GRBL's `<Idle|MPos:…>`
     values_only: bool = False  # a reply of its values alone, no code: read as the answer to the request before it
 
@@ -160,14 +161,16 @@ class TextFrame:
         """The response that answers a request: its own command's, or the one it is `answered_by`."""
         return self.response(request.answered_by or request.key)
 
-    def answers(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-        """Each request code answered by another command (`answered_by`) or refused by some (`refused_by`) -> the
-        codes of the responses that answer it and of those that refuse it."""
+    def answers(self) -> dict[str, tuple[tuple[str, ...], ...]]:
+        """Each request code answered by another command (`answered_by`), refused by some (`refused_by`) or whose
+        answer ends with another's response (`then`) -> the codes of the responses that answer it, of those that
+        refuse it, and (with `then`) of the one that ends the answer."""
         codes = {m.key: m.code for m in self.messages if m.direction == Direction.RESPONSE}
         return {
             m.code: ((codes[m.answered_by or m.key],), tuple(codes[k] for k in m.refused_by))
+            + (((codes[m.then],),) if m.then else ())
             for m in self.messages
-            if m.direction == Direction.REQUEST and (m.answered_by or m.refused_by)
+            if m.direction == Direction.REQUEST and (m.answered_by or m.refused_by or m.then)
         }
 
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:

@@ -113,6 +113,10 @@ class TextPass(Pass):
                     self.error((*asked, "refused_by", index), f"{name!r} is not a command with a response")
                 elif name == message.answered_by:
                     self.error((*asked, "refused_by", index), f"{name!r} is the reply that answers it")
+            if message.then and message.then not in responses:
+                self.error((*asked, "then"), f"{message.then!r} is not a command with a response")
+            elif message.then and message.then in (message.answered_by or message.key, *message.refused_by):
+                self.error((*asked, "then"), f"{message.then!r} is the reply or a refusal: `then` names what ends it")
         if frame is not None:
             frame = replace(frame, messages=tuple(messages))
             examples = tuple(self.examples(frame))
@@ -290,6 +294,7 @@ class TextPass(Pass):
             source=str(raw.get("source") or command.get("source", "")),
             answered_by=str(answered_by.get("command", "")),
             refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
+            then=str(answered_by.get("then", "")),
             layout=layout,
             values_only=values_only,
         )

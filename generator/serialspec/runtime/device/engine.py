@@ -147,6 +147,7 @@ class CommandSpec:
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
     carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
     refusal: type[Message] | None = None  # the reply of another command a refused request gets (`refused_by`)
+    final: type[Message] | None = None  # the response that ends each answer, after the reply (text frames' `then`)
     # (request field, code -> request class): the request asks for the command whose code the field holds, and the
     # device acts as on that command's request (`answered_by: {command_in: FIELD}`)
     asks: tuple[str, dict[int, type[Message]]] | None = None
@@ -814,7 +815,15 @@ class Engine(FaultInjection):
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
         nest(values, command.nothing_held if refused == "held" else self.spec.errors.get(refused, {}))
-        return self._encode_reply(response, values)
+        reply = self._encode_reply(response, values)
+        if reply is not None and command.final is not None and response is command.response:
+            # the answer's end (an AT command's OK): its fields the device's `reply` values, else their blanks
+            ending = self._encode_reply(
+                command.final,
+                {name: self.spec.reply.get(name, command.blanks.get(name)) for name in field_keys(command.final)},
+            )
+            reply = None if ending is None else reply + ending
+        return reply
 
     # --- data spaces and error replies ------------------------------------------------------------------------------
 

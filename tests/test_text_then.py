@@ -1,0 +1,145 @@
+"""A text request whose answer ends with another command's response (`answered_by: {then: ...}`): an AT-command
+module (HC-05 style) answers `AT+VERSION?` with `+VERSION:...` and then `OK`. The client returns the reply once the
+`OK` has come too, so the next request does not take that `OK` for its own answer; the simulator sends both."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+from serialspec.lang import load_protocol
+from serialspec.lang.errors import SpecErrors
+
+SPEC = """
+protocol: atmodule
+title: An AT-command module
+serial: {baudrate: 38400}
+framing:
+  kind: text
+  separator: ":"
+  end: "\\r\\n"
+commands:
+  ok:
+    code: OK
+    response: {unsolicited: true}
+  error:
+    code: ERROR
+    response:
+      unsolicited: true
+      fields:
+        reason: {type: integer, range: [0, 255]}
+  version_info:
+    code: "+VERSION"
+    response:
+      unsolicited: true
+      fields:
+        version: {type: text}
+  version:
+    code: "AT+VERSION?"
+    request: {answered_by: {command: version_info, then: ok, refused_by: [error]}}
+  reset:
+    code: "AT+RESET"
+    request: {answered_by: {command: ok, refused_by: [error]}}
+device:
+  state: {}
+  reply: {version: "2.0-20100601"}
+"""
+
+
+@pytest.fixture(scope="module")
+def module(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ModuleType]:
+    from conftest import generate_and_import
+
+    folder = tmp_path_factory.mktemp("atmodule")
+    path = folder / "atmodule.yaml"
+    path.write_text(SPEC, "utf-8")
+    yield generate_and_import(path, folder / "out", "atmodule")
+    for name in [m for m in sys.modules if m.partition(".")[0] == "atmodule"]:
+        del sys.modules[name]
+
+
+def test_the_answer_names_its_end(tmp_path: Path) -> None:
+    path = tmp_path / "atmodule.yaml"
+    path.write_text(SPEC, "utf-8")
+    text = load_protocol(path).text
+    assert text is not None
+    assert text.answers()["AT+VERSION?"] == (("+VERSION",), ("ERROR",), ("OK",))
+    assert text.answers()["AT+RESET"] == (("OK",), ("ERROR",))  # no `then`: as before
+
+
+def test_the_client_waits_for_the_ok_and_the_next_request_gets_its_own(module: ModuleType) -> None:
+    """Against the simulator, which sends `+VERSION:...` then `OK`: the version comes back, and the reset after it
+    is answered by its own `OK` (without `then`, the version's `OK` would be read as the reset's answer: that the
+    reset's `OK` is its own shows in the nothing left unread after it)."""
+    simulator = importlib.import_module("atmodule.simulator").SIMULATOR()
+    try:
+        with module.Client(simulator.start()) as client:
+            reply = client.version(timeout=5)
+            assert isinstance(reply, module.VersionInfoResponse) and reply.version == "2.0-20100601"
+            assert isinstance(client.reset(timeout=5), module.OkResponse)
+            assert client.read(0.3) == []
+    finally:
+        simulator.close()
+
+
+@pytest.mark.parametrize(
+    ("answer", "raised"),
+    [
+        (b"ERROR:29\r\n", r"^version \(AT\+VERSION\?\): the device refused it"),
+        (b"+VERSION:2.0\r\nERROR:1\r\n", r"^version \(AT\+VERSION\?\): the device refused it"),
+        (b"OK\r\n", r"^version \(AT\+VERSION\?\): the device ended its answer .* without a reply"),
+        (b"+VERSION:2.0\r\n", r"^version \(AT\+VERSION\?\): its reply came, but not the 'OK' that ends the answer"),
+    ],
+)
+def test_a_refusal_an_answer_without_its_reply_or_without_its_end(
+    module: ModuleType, answer: bytes, raised: str
+) -> None:
+    from pty_pair import answering_line
+    from serialspec.runtime.errors import DeviceError, Timeout
+
+    error = Timeout if answer.endswith(b"2.0\r\n") else DeviceError
+    with (
+        answering_line(b"AT+VERSION?\r\n", answer) as name,
+        module.Client(name) as client,
+        pytest.raises(error, match=raised),
+    ):
+        client.version(timeout=0.5)
+
+
+@pytest.mark.parametrize(
+    ("then", "said"),
+    [
+        ("okay", "commands.version.request.answered_by.then: 'okay' is not a command with a response"),
+        ("version_info", "commands.version.request.answered_by.then: 'version_info' is the reply or a refusal"),
+        ("error", "commands.version.request.answered_by.then: 'error' is the reply or a refusal"),
+    ],
+)
+def test_then_mistakes_are_one_line_each(tmp_path: Path, then: str, said: str) -> None:
+    path = tmp_path / "atmodule.yaml"
+    path.write_text(SPEC.replace("then: ok,", f"then: {then},"), "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(path)
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1 and said in lines[0], lines
+
+
+def test_a_binary_spec_is_told_then_is_for_text_frames(tmp_path: Path) -> None:
+    from conftest import ROOT
+
+    spec = (ROOT / "specs" / "ubx.yaml").read_text("utf-8")
+    changed = spec.replace(
+        "answered_by: {command: ack_ack, refused_by: [ack_nak]}",
+        "answered_by: {command: ack_ack, refused_by: [ack_nak], then: ack_ack}",
+        1,
+    )
+    assert changed != spec
+    path = tmp_path / "ubx.yaml"
+    path.write_text(changed, "utf-8")
+    with pytest.raises(SpecErrors) as caught:
+        load_protocol(path)
+    lines = str(caught.value).splitlines()
+    assert len(lines) == 1 and "answered_by.then: `then` is for text frames" in lines[0], lines

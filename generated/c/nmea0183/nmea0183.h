@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "b50f0eceea9997d7c86f0d7ba5f980852959573886b2feb1e4e7abe07173229a"
+#define NMEA0183_SPEC_SHA256 "8e42a551f2927da7fc460766161e4dc4c0f5e636f1956b5db72ac1f318856204"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -36,7 +36,7 @@ KINDS = ("decimal", "integer", "angle", "char", "text", "time", "date")
 # Keys a text field may have, by kind (besides type, use, description, unit)
 KIND_KEYS = {
     "decimal": {"precision", "width", "range"},
-    "integer": {"width", "range"},
+    "integer": {"width", "range", "base", "case"},
     "angle": {"precision", "width", "range"},
     "char": {"letters"},
     "text": {"size"},
@@ -139,6 +139,14 @@ class TextPass(Pass):
                 self.error((*path, "start"), "give each direction its own start, two different characters")
         # a separator or end missing or not text (said above, or by the grammar): stand-ins that clash with nothing,
         # so that no second line blames the characters of a value that is not there
+        ends = raw.get("end")
+        response_end = ""
+        if isinstance(ends, dict):  # one per direction: an ELM327's CR after a request, `\r\r>` after a reply
+            raw = {**raw, "end": str(ends.get("request") or "")}
+            response_end = str(ends.get("response") or "")
+            if not raw["end"] or not response_end or raw["end"] == response_end:
+                self.error((*path, "end"), "give each direction its own line ending, two different texts")
+                response_end = ""
         separator, end = (
             raw[k] if isinstance(raw.get(k), str) and raw[k] else stand_in
             for k, stand_in in (("separator", "\x1f"), ("end", "\x1e"))
@@ -174,9 +182,10 @@ class TextPass(Pass):
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
         if any(not " " <= c <= "~" for c in (start, response_start, separator) if c):
             self.error(path, "`start` and `separator` are printable ASCII characters")
-        if any(c > "\xff" for c in end):
+        if any(c > "\xff" for c in end + response_end):
             self.error((*path, "end"), "the line ending's characters are bytes: U+0000 to U+00FF (Nextion: \\xFF)")
-        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *set(end)]
+        ending = set(end) | set(response_end)
+        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *ending]
         special += [marker] if algorithm is not None else []
         if len(set(special)) != len(special):
             self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
@@ -198,6 +207,7 @@ class TextPass(Pass):
             checksum_separated=separated,
             response_start=response_start,
             address=self.address(raw["address"]) if "address" in raw else None,
+            response_end=response_end,
         )
 
     def address(self, name: Any) -> TextField | None:
@@ -224,7 +234,7 @@ class TextPass(Pass):
         code = command.get("code")
         # the framing's own characters would cut the code out of its frame (`$` starts NMEA sentences)
         framing = (
-            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end} - {""}
+            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end, *frame.response_end} - {""}
             if frame is not None
             else set()
         )
@@ -258,6 +268,8 @@ class TextPass(Pass):
             if any(item.name == frame.address.name for item in fields):
                 self.error((*where, "fields", frame.address.name), "the framing's `address` is every message's already")
             fields = (frame.address, *fields)
+        if isinstance(raw.get("text"), dict) and "code" in raw["text"]:  # a code of its own: ELM327's reply `41 0C`
+            code = self.own_code(raw["text"], (*where, "text"), frame, allowed)
         layout = (
             self.layout(raw["text"], code, fields, (*where, "text"), frame)
             if "text" in raw and isinstance(raw["text"], dict)
@@ -294,6 +306,18 @@ class TextPass(Pass):
             values_only=values_only,
         )
 
+    def own_code(self, raw: dict[str, Any], path: Path, frame: TextFrame | None, allowed: set[str]) -> str:
+        """A message's code of its own (`text: {code}`): a code's characters, and the message's separator between
+        words where it has no `start` of its own (it is found by the code at the start of the frame)."""
+        code = raw["code"]
+        separator = str(raw.get("separator", frame.separator if frame is not None else ","))
+        words = code.split(separator) if isinstance(code, str) and separator and not raw.get("start") else [code]
+        if not isinstance(code, str) or not all(w and set(w) <= allowed for w in words):
+            shown = "".join(sorted(set(CODE_PUNCTUATION) & allowed))
+            between = f", words between single {separator!r}" if separator and not raw.get("start") else ""
+            raise self.fail((*path, "code"), f"a text code is letters, digits and {shown}{between}; got {code!r}")
+        return code
+
     def found_by_code(self, messages: list[TextMessage]) -> None:
         """Each message found by its code alone (its own text without a `start`) is told from every other code: the
         code and what follows it (`after_code`, else the separator) begin no other code, unless the code is glued
@@ -328,7 +352,11 @@ class TextPass(Pass):
         frame: TextFrame | None,
     ) -> TextLayout:
         """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
-        framing = {frame.start, frame.response_start, frame.marker, *frame.end} - {""} if frame is not None else set()
+        framing = (
+            {frame.start, frame.response_start, frame.marker, *frame.end, *frame.response_end} - {""}
+            if frame is not None
+            else set()
+        )
         given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
         given.setdefault("separator", frame.separator if frame is not None else ",")
         glued = given.get("named") == ""  # labels glued to their values: G-code's `X10.5`, LSS's `D1800T1500`
@@ -349,7 +377,7 @@ class TextPass(Pass):
             self.error(path, "`separator`, `named` and `list` differ from each other and from the framing's characters")
         if set(layout.after_code or "") & framing:
             self.error((*path, "after_code"), "`after_code` differs from the framing's characters")
-        if set(code) & set(single + [layout.after_code or ""]) - {""}:
+        if set(code) & set(single + [layout.after_code or ""]) - {"", "" if layout.start else layout.separator}:
             self.error(path, f"the code {code!r} holds one of the message's own characters")
         if not layout.start and not glued and any(item.label == code for item in fields):
             self.error(path, "a field labelled with the code needs the message's own `start`")
@@ -471,7 +499,15 @@ class TextPass(Pass):
             letters_class=letters_class,
             label=str(spec.get("label", "")),
             rest=self.rest(spec, path, top),
+            base=16 if spec.get("base") == 16 else 10,
+            lower=self.lower(spec, path),
         )
+
+    def lower(self, spec: dict[str, Any], path: Path) -> bool:
+        """`case: lower` (hex digits written in lower case), which only an integer of `base: 16` has."""
+        if "case" in spec and spec.get("base") != 16:
+            self.error((*path, "case"), "`case` is that of hex digits: it needs `base: 16`")
+        return spec.get("case") == "lower"
 
     def rest(self, spec: dict[str, Any], path: Path, top: bool) -> bool:
         """A text field's `size: rest`: the rest of the line, separators included (the last field of a message)."""

@@ -1534,6 +1534,42 @@ FRAMING = Obj(
         "The frame every command travels in: `elements` (one layout) or `layouts` (alternatives), or with "
         "`kind: text` a line of text fields."
     ),
+    variants=(
+        (
+            "Text frames whose replies are not written as their requests (an ELM327 OBD-II adapter: `010C` and CR "
+            "asked, `41 0C 1A F8 ` answered, then CR, a blank line and its `>` prompt)",
+            {
+                "framing": {"kind": "text", "separator": " ", "end": {"request": "\r", "response": "\r\r>"}},
+                "commands": {
+                    "engine_rpm": {
+                        "code": "010C",
+                        "request": {"fields": {}},
+                        "response": {
+                            "text": {"code": "41 0C", "end": " "},
+                            "fields": {
+                                "a": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                                "b": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                            },
+                        },
+                    }
+                },
+            },
+            "Three keys of text frames, each usable alone. `end` as a mapping gives each direction its own line "
+            "ending: encode, the client and the simulator write a frame's own, decode takes it off, the stream "
+            "parser of one direction waits for that direction's and one of both directions (a monitor's) takes "
+            "the longest that ends a frame (a request's CR is not taken while the CR CR `>` of a reply may still "
+            "come). A response's `text: {code: ...}` is the code its frames carry instead of its command's, here "
+            'two words (mode + 0x40, then the PID), and `end: " "` the space after its last byte; the reply is '
+            "found by that code (the longest that fits), and the client, the simulator and the stream parser pair "
+            'it with its request as usual. An AT modem\'s `+CSQ: 20,99` answering `AT+CSQ` is `code: "+CSQ:"` '
+            'with `after_code: " "` (the framing\'s `separator: ","` between its values). `base: 16` writes an '
+            "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
+            "zero-padded to `width` digits, "
+            "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it and the "
+            "Wireshark dissector refuse line endings by direction and reply codes of their own, one line each.",
+        ),
+    ),
 )
 
 EXAMPLE = Obj(

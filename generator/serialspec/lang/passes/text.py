@@ -269,7 +269,7 @@ class TextPass(Pass):
                 self.error((*where, "fields", frame.address.name), "the framing's `address` is every message's already")
             fields = (frame.address, *fields)
         if isinstance(raw.get("text"), dict) and "code" in raw["text"]:  # a code of its own: ELM327's reply `41 0C`
-            code = self.own_code(raw["text"], (*where, "text"), frame, allowed)
+            code = self.own_code(raw["text"], (*where, "text"), frame, allowed) or code
         layout = (
             self.layout(raw["text"], code, fields, (*where, "text"), frame)
             if "text" in raw and isinstance(raw["text"], dict)
@@ -308,14 +308,18 @@ class TextPass(Pass):
 
     def own_code(self, raw: dict[str, Any], path: Path, frame: TextFrame | None, allowed: set[str]) -> str:
         """A message's code of its own (`text: {code}`): a code's characters, and the message's separator between
-        words where it has no `start` of its own (it is found by the code at the start of the frame)."""
+        words where it has no `start` of its own (it is found by the code at the start of the frame). "" where it
+        is not one (said): the message keeps its command's, so that nothing else about it is reported again."""
         code = raw["code"]
         separator = str(raw.get("separator", frame.separator if frame is not None else ","))
         words = code.split(separator) if isinstance(code, str) and separator and not raw.get("start") else [code]
         if not isinstance(code, str) or not all(w and set(w) <= allowed for w in words):
             shown = "".join(sorted(set(CODE_PUNCTUATION) & allowed))
             between = f", words between single {separator!r}" if separator and not raw.get("start") else ""
-            raise self.fail((*path, "code"), f"a text code is letters, digits and {shown}{between}; got {code!r}")
+            if raw.get("start") and isinstance(code, str) and separator and separator in code:
+                between = f" (words between {separator!r} only in a message found by its code: no `start`)"
+            self.error((*path, "code"), f"a text code is letters, digits and {shown}{between}; got {code!r}")
+            return ""
         return code
 
     def found_by_code(self, messages: list[TextMessage]) -> None:

@@ -2312,6 +2312,10 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
     refused["framing"]["address"] = "side"
     with pytest.raises(SpecErrors, match=r"framing\.address: the address 'side' is an integer field"):
         resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
+    refused = copy.deepcopy(case)
+    refused["fields"]["unit"]["base"] = 16  # hex digits could not be told from a code's letters
+    with pytest.raises(SpecErrors, match=r"framing\.address: the address 'unit' is read as the decimal digits"):
+        resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
 
 
 def test_labels_glued_to_their_values_through_every_output() -> None:
@@ -2352,7 +2356,8 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
         streams_back(package, (package.MoveResponse, package.WordsResponse, package.AnswerResponse), "response")
     for command, field, change, expected in (
         ("move", "time", {"label": "SDX"}, "label 'SD' begins another label"),
-        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a number"),
+        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a decimal number"),
+        ("move", "time", {"base": 16}, "without a separator, a value glued between labels is a decimal number"),
         ("words", "y", {"label": "X1"}, "label 'X' begins another label"),
     ):
         broken = copy.deepcopy(case)

@@ -224,6 +224,8 @@ class TextPass(Pass):
             return None
         if found.minimum is not None and found.minimum < 0:
             self.error(path, f"the address {name!r} is written as digits alone: its range starts at 0 or above")
+        if found.base != 10:
+            self.error(path, f"the address {name!r} is read as the decimal digits before the code: not `base: 16`")
         return replace(found, address=True)
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
@@ -334,7 +336,8 @@ class TextPass(Pass):
             after = layout.separator if layout.after_code is None else layout.after_code
             sent = [f for f in message.fields if not (isinstance(f, TextField) and f.address)]
             first = sent[0] if sent else None
-            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal")
+            # a decimal number (hex digits could go on as another code's letters)
+            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal") and first.base == 10
             for other in sorted(codes):
                 if other == message.code or not other.startswith(message.code + after):
                     continue
@@ -415,8 +418,10 @@ class TextPass(Pass):
             where = (*path[:-1], "fields", item.name)
             if isinstance(item, TextRepeat):
                 self.error(where, 'a repeat in a message whose labels are glued to their values (`named: ""`)')
-            elif not layout.separator and item.kind not in ("integer", "decimal"):
-                self.error(where, "without a separator, a value glued between labels is a number (integer, decimal)")
+            elif not layout.separator and (item.kind not in ("integer", "decimal") or item.base != 10):
+                self.error(
+                    where, "without a separator, a value glued between labels is a decimal number (integer, decimal)"
+                )
         for label in labels:
             if any(other != label and other.startswith(label) for other in labels):
                 self.error((*path[:-1], "fields"), f"label {label!r} begins another label: a value could follow either")

@@ -46,7 +46,7 @@ def test_what_the_loader_says_to_the_first_draft(tmp_path: Path) -> None:
     assert said[0].endswith(
         "commands.engine_rpm.response.fields.pid.const: `const` does not apply to a integer field in a text frame"
     )
-    assert said[1].endswith("commands.vehicle_speed.code: code '41' is also engine_rpm's")
+    assert said[1].endswith("commands.vehicle_speed.response.text.code: code '41' is also engine_rpm's")
     load_protocol(SPEC)  # the spec as written now
 
 

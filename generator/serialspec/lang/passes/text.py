@@ -98,10 +98,13 @@ class TextPass(Pass):
                     if message is not None:
                         messages.append(message)
         codes: dict[str, TextMessage] = {}
-        for message in messages:  # a command's request and response share its code
+        commands = self.section("commands")
+        for message in messages:  # a command's request and response share its code, unless one has its own
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
-                self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+                own = message.code != (commands.get(message.key) or {}).get("code")
+                where: Path = ("commands", message.key, *((message.direction.value, "text") if own else ()), "code")
+                self.error(where, f"code {message.code!r} is also {other.key}'s")
         self.found_by_code(messages)
         responses = {m.key for m in messages if m.direction == Direction.RESPONSE}
         for message in messages:

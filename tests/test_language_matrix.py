@@ -1840,6 +1840,8 @@ TEXT_CASE: dict[str, Any] = {
                 "fields": {
                     "d": {"type": "decimal", "precision": 2, "width": 3, "range": [0, 500], "unit": "V"},
                     "i": {"type": "integer", "width": 2, "range": [0, 99]},
+                    "x": {"type": "integer", "base": 16, "width": 4, "range": [0, 65535]},  # hex digits: `0A3F`
+                    "lx": {"type": "integer", "base": 16, "case": "lower", "range": [-4096, 4096]},  # `-fa`
                     "a": {"type": "angle", "width": 3, "precision": 3, "range": [0, 180]},
                     "h": {"use": "side"},
                     "g": "side",
@@ -1943,6 +1945,62 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         # both directions in one stream (a monitor's): the answer right after its request is the response
         both = package.StreamParser()
         assert both.feed(package.encode(asked) + frame) == [asked, answer]
+        # integers in hex digits (`base: 16`): upper case, zero-padded to the width; `case: lower`; either case read
+        hexed = package.FRAMING.encode("EV", {"x": 0x0A3F, "lx": -250}, "A", direction="request")
+        assert hexed.startswith(b"#AEV;;;0A3F;-fa;"), hexed
+        assert package.FRAMING.decode(b"#AEV;;;0a3f;-FA" + hexed[15:]).values["lx"] == -250
+
+
+def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output() -> None:
+    """`end: {request: ..., response: ...}` and a response's `text: {code: ...}` of several words (an ELM327's `010C`
+    answered `41 0C 1A F8 ` and CR CR `>`): C and Wireshark refuse each in one line; the reference says both; each
+    direction ends with its own; the reply is found by its own code, the simulator answers with it and the codec
+    pairs it with its request; random messages round trip, all in one stream of both directions read byte by byte;
+    misuse (and of `base`, `case`) refused one line each."""
+
+    case = copy.deepcopy(TEXT_CASE)
+    case["framing"]["end"] = {"request": "\n", "response": "\n\n>"}
+    case["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
+    files = python_and_markdown(case, r"^a line ending of its own for each direction \(`end: \{request: \.\.\.")
+    docs = files["docs/matrix_text.md"]
+    assert "| end | LF (requests), LF LF > (responses) |" in docs
+    assert "`DialResponse`, a response, under a code of its own (its request's is `DL`)" in docs
+    own_code = copy.deepcopy(case)
+    own_code["framing"]["end"] = "\n"
+    python_and_markdown(own_code, r"^a reply under a code of its own \(`text: \{code: \.\.\.\}`\)$")
+    modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
+    with imported("matrix_text", modules, "the language matrix") as package:
+        asked = package.DialRequest(talker="A", level=7, note="hi")
+        assert package.encode(asked).endswith(b"\n") and not package.encode(asked).endswith(b">")
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        [(_, frame)] = device.feed(package.encode(asked))
+        assert frame.startswith(b"#ARE;DL;7;") and frame.endswith(b"\n\n>"), frame
+        answer = package.decode(frame)
+        assert (answer.level, answer.volts, answer.note) == (7, 25, "hi") and package.encode(answer) == frame
+        assert package.CODEC.replies("DL")[0] == (package.DialResponse,)  # what a client awaits after `DL`
+        frames, messages = b"", []
+        for cls in package.MESSAGE_TYPES:
+            more, decoded = random_frames(package, cls, 10)
+            frames, messages = frames + more, messages + decoded
+        parser = package.StreamParser()  # both directions: a request's LF is not the start of a reply's ending
+        assert [m for byte in frames + b"\x00" for m in parser.feed(bytes([byte]))] == messages
+    for where, change, expected in (
+        (("framing", "end"), {"request": "\n", "response": "\n"}, "framing.end: give each direction its own"),
+        (("commands", "dial", "response", "text"), {"code": "RE;;DL"}, "text.code: a text code is letters, digits"),
+        (("commands", "dial", "response", "text"), {"code": "RE;DL", "start": "<"}, "a text code is letters"),
+        (("commands", "dial", "request", "fields", "level"), {"type": "integer", "case": "lower"}, "needs `base: 16`"),
+        (("commands", "dial", "request", "fields", "level"), {"type": "decimal", "base": 16}, "`base` does not apply"),
+        (("commands", "dial", "request", "fields", "level"), {"type": "integer", "base": 8}, "expected one of 10, 16"),
+    ):
+        broken = copy.deepcopy(case)
+        target = broken
+        for key in where[:-1]:
+            target = target[key]
+        target[where[-1]] = change
+        with pytest.raises(SpecErrors) as refused:
+            resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
+        lines = str(refused.value).splitlines()
+        assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines
 
 
 def test_a_reply_of_values_alone_through_every_output() -> None:
@@ -2303,6 +2361,10 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
     refused["framing"]["address"] = "side"
     with pytest.raises(SpecErrors, match=r"framing\.address: the address 'side' is an integer field"):
         resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
+    refused = copy.deepcopy(case)
+    refused["fields"]["unit"]["base"] = 16  # hex digits could not be told from a code's letters
+    with pytest.raises(SpecErrors, match=r"framing\.address: the address 'unit' is read as the decimal digits"):
+        resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
 
 
 def test_labels_glued_to_their_values_through_every_output() -> None:
@@ -2343,7 +2405,8 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
         streams_back(package, (package.MoveResponse, package.WordsResponse, package.AnswerResponse), "response")
     for command, field, change, expected in (
         ("move", "time", {"label": "SDX"}, "label 'SD' begins another label"),
-        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a number"),
+        ("move", "time", {"type": "text"}, "without a separator, a value glued between labels is a decimal number"),
+        ("move", "time", {"base": 16}, "without a separator, a value glued between labels is a decimal number"),
         ("words", "y", {"label": "X1"}, "label 'X' begins another label"),
     ):
         broken = copy.deepcopy(case)

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "0ec6ace3b51997652c2f1511870f707d3bb62aa3ab4c4f5a2607f5abbca63f40"
+#define NMEA0183_SPEC_SHA256 "330a991fe0ea76a006a60146fbfbf2fb4eafd6fb986f3ef919f733451f42f204"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

@@ -81,7 +81,8 @@ class Printer:
             if self.protocol.text is not None:  # a sentence: its fields as the texts sent, and the line itself
                 record: Any = message  # a text record: its frame's descriptor of its code
                 fields = texts(record.FRAMING.sentence(record.CODE, record.DIRECTION.value), fields)
-                line = seen.data.decode("latin-1").removesuffix(self.protocol.text.end).rstrip("\r\n")
+                ending = self.protocol.text.end_of(message.DIRECTION)
+                line = seen.data.decode("latin-1").removesuffix(ending).rstrip("\r\n")
                 text = f"{what} {json.dumps(fields, ensure_ascii=False)} {line}"
             else:
                 text = f"{what} {json.dumps(fields, ensure_ascii=False)} [{seen.data.hex(' ')}]"

@@ -53,7 +53,7 @@ def describe(
         "checksum_ok": True
         if framing.checksum is not None and framing.marker in body and sentence.direction in framing.checksummed
         else None,
-        "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
+        "text": body.removesuffix(framing.end_of(sentence.direction)),
     }
 
 
@@ -128,5 +128,5 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
     if as_hex:
         print(frame.hex(" "))
     else:
-        print(frame.decode("latin-1").removesuffix(framing.end))
+        print(frame.decode("latin-1").removesuffix(framing.end_of(cls.DIRECTION.value)))
     return 0

@@ -551,6 +551,20 @@ _FIELD_LONG: dict[str, Shape] = {
         maximum=20,
         example=3,
     ),
+    "base": Num(
+        "text integer: the digits' base, 10 or 16 (hex digits: an ELM327's `41 0C 1A F8`, `a: {type: integer, base: "
+        "16, width: 2}`). Hex digits decode in either case and encode in upper case (`case: lower`: lower), after a "
+        "`-` for a negative value; `width` counts digits, zero-padded.",
+        default=10,
+        example=16,
+        choices=(10, 16),
+    ),
+    "case": Str(
+        "text integer with `base: 16`: the case of the hex digits written (decode reads either).",
+        default="upper",
+        example="lower",
+        choices=("upper", "lower"),
+    ),
     "letters": MapOf(
         Str(), "text char: label -> the letter that stands for it; decoded letters become members of a generated Enum."
     ),
@@ -634,6 +648,15 @@ TEXT_LAYOUT = Obj(
             "code, then `after_code`, then the fields (Roboteq's `A=12:13` answering `?A`: `text: {separator: "
             '"=", list: ":"}`).',
             example="<",
+        ),
+        "code": Str(
+            "The code this message's frames carry where it is not its command's `code`: a reply under a code of its "
+            'own (an ELM327 answers `010C` with `41 0C 1A F8`: `response: {text: {code: "41 0C"}}`; an AT modem '
+            'answers `AT+CSQ` with `+CSQ: 20,99`: `text: {code: "+CSQ:", after_code: " "}`). It may hold '
+            "the message's separator (several words); the message is found by it, the longest code that fits, and "
+            "clients and the simulator pair it with its request as usual. The C target and the Wireshark dissector "
+            "refuse it, saying so.",
+            example="41 0C",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
         "separator": Str(
@@ -1397,9 +1420,9 @@ FRAMING = Obj(
         "kind": Str(
             "binary: frames of bytes described by `elements` or `layouts`; text: line-oriented text frames "
             "(`start`, `separator`, `checksum`, `end`, `talker`), each message chosen by its command's text `code`; "
-            "a command's request and its response share the code (decode takes the direction; the simulator reads "
-            "requests, the client answers; a text device answers as its `device.commands` entry says: `stores`, "
-            "`sets`, `reports`, `echoes`).",
+            "a command's request and its response share the code, unless its `text` gives another (decode takes "
+            "the direction; the simulator reads requests, the client answers; a text device answers as its "
+            "`device.commands` entry says: `stores`, `sets`, `reports`, `echoes`).",
             choices=("binary", "text"),
             default="binary",
             example="text",
@@ -1423,7 +1446,24 @@ FRAMING = Obj(
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),
-        "end": Str("text: the line ending that closes every frame.", example="\r\n"),
+        "end": OneOf(
+            (
+                Str(),
+                Obj(
+                    {
+                        "request": Str("The requests' line ending (`\\r`).", example="\r"),
+                        "response": Str("The responses' line ending (`\\r\\r>`).", example="\r\r>"),
+                    },
+                    required=("request", "response"),
+                ),
+            ),
+            "text: the line ending that closes every frame. A mapping gives each direction its own (an ELM327 "
+            'OBD-II adapter: `end: {request: "\\r", response: "\\r\\r>"}`, its reply ended by CR, a blank line '
+            "and its `>` prompt): the stream parser of one direction waits for that direction's, and one reading "
+            "both takes the longest that ends a frame. The C target and the Wireshark dissector refuse line endings "
+            "that differ by direction, saying so.",
+            example="\r\n",
+        ),
         "checksum": Obj(
             {
                 "algorithm": Str(
@@ -1502,6 +1542,42 @@ FRAMING = Obj(
     description=(
         "The frame every command travels in: `elements` (one layout) or `layouts` (alternatives), or with "
         "`kind: text` a line of text fields."
+    ),
+    variants=(
+        (
+            "Text frames whose replies are not written as their requests (an ELM327 OBD-II adapter: `010C` and CR "
+            "asked, `41 0C 1A F8 ` answered, then CR, a blank line and its `>` prompt)",
+            {
+                "framing": {"kind": "text", "separator": " ", "end": {"request": "\r", "response": "\r\r>"}},
+                "commands": {
+                    "engine_rpm": {
+                        "code": "010C",
+                        "request": {"fields": {}},
+                        "response": {
+                            "text": {"code": "41 0C", "end": " "},
+                            "fields": {
+                                "a": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                                "b": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                            },
+                        },
+                    }
+                },
+            },
+            "Three keys of text frames, each usable alone. `end` as a mapping gives each direction its own line "
+            "ending: encode, the client and the simulator write a frame's own, decode takes it off, the stream "
+            "parser of one direction waits for that direction's and one of both directions (a monitor's) takes "
+            "the longest that ends a frame (a request's CR is not taken while the CR CR `>` of a reply may still "
+            "come). A response's `text: {code: ...}` is the code its frames carry instead of its command's, here "
+            'two words (mode + 0x40, then the PID), and `end: " "` the space after its last byte; the reply is '
+            "found by that code (the longest that fits), and the client, the simulator and the stream parser pair "
+            'it with its request as usual. An AT modem\'s `+CSQ: 20,99` answering `AT+CSQ` is `code: "+CSQ:"` '
+            'with `after_code: " "` (the framing\'s `separator: ","` between its values). `base: 16` writes an '
+            "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
+            "zero-padded to `width` digits, "
+            "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it and the "
+            "Wireshark dissector refuse line endings by direction and reply codes of their own, one line each.",
+        ),
     ),
 )
 

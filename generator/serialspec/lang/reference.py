@@ -60,7 +60,7 @@ def type_text(shape: Shape) -> str:
     if isinstance(shape, Int):
         return "integer"
     if isinstance(shape, Num):
-        return "number"
+        return "one of " + ", ".join(f"`{c:g}`" for c in shape.choices) if shape.choices else "number"
     if isinstance(shape, Bool):
         return "true or false"
     if isinstance(shape, ListOf):

@@ -113,6 +113,8 @@ class TextField:
     label: str = ""  # in a message with its own layout (TextLayout.named): the label its value follows
     address: bool = False  # every message's first field, its digits right after the start, before the code (LSS's id)
     rest: bool = False  # text: the rest of the line, separators included (`size: rest`: Marlin's `Error:...`)
+    base: int = 10  # integer: its digits' base (16: hex digits, read in either case: an ELM327's `1A F8`)
+    lower: bool = False  # integer of base 16: its hex digits written in lower case
 
 
 @dataclass(frozen=True)
@@ -211,6 +213,7 @@ class TextFraming:
     checksummed: tuple[str, ...] = ("request", "response")  # the directions whose frames carry the checksum
     separated: tuple[str, ...] = ()  # the directions whose frames write the separator before the checksum's marker
     response_start: str = ""  # the responses' own start, where it differs from the requests' (`start`): LSS's `*`
+    response_end: str = ""  # the responses' own line ending, where it differs from the requests' (`end`): ELM327's
     # code -> direction -> its sentence
     by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
@@ -258,8 +261,11 @@ class TextFraming:
         `direction` is needed only for a code that names a request and a response. `reply`: the code of the reply
         awaited (the answer to the request before this frame; given, the request is known): where that reply is its
         values alone (`bare`), a frame that does not start with another message's code is read as it."""
-        text = _ascii(frame, self.end)
-        if text.endswith(self.end):
+        text = _ascii(frame, self.end, self.response_end)
+        if self.response_end:  # each direction its own line ending: the longest that ends the frame is taken off
+            ending = self._ending(text, direction)
+            text = text[: len(text) - len(ending)]
+        elif text.endswith(self.end):
             text = text[: -len(self.end)]
         if self.response_start:  # each direction its own start: the start says the direction
             said = "response" if text.startswith(self.response_start) else "request"
@@ -464,6 +470,15 @@ class TextFraming:
         body = self.separator.join(parts if sentence.bare else [talker + code, *parts])
         return self.frame(address + body, sentence.direction, unchecked)
 
+    def _ending(self, text: str, direction: str | None) -> str:
+        """The line ending `text` ends with (of `direction`, or the longest of either; "" for none)."""
+        ends = [self.end_of(direction)] if direction is not None else [self.end, self.response_end]
+        return max((e for e in ends if text.endswith(e)), key=len, default="")
+
+    def end_of(self, direction: str | None) -> str:
+        """The line ending of a frame in `direction` (the requests' where the responses have none of their own)."""
+        return self.response_end if direction == "response" and self.response_end else self.end
+
     def start_of(self, direction: str | None) -> str:
         """The start of a frame in `direction` (the requests' where the responses have none of their own)."""
         return self.response_start if direction == "response" and self.response_start else self.start
@@ -478,7 +493,8 @@ class TextFraming:
                 text, body = text + self.separator, body + self.separator
             value = self.checksum(body.encode("ascii"))
             text += f"{self.marker}{value}" if self.decimal else f"{self.marker}{value:0{self.digits}X}"
-        return (text + self.end).encode("latin-1")  # the line ending may hold bytes above 0x7F (Nextion's FF FF FF)
+        # the line ending may hold bytes above 0x7F (Nextion's FF FF FF)
+        return (text + self.end_of(direction)).encode("latin-1")
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
         return self.encode(
@@ -489,7 +505,8 @@ class TextFraming:
         """The framing's own characters, which no field of a frame in `direction` may hold (the checksum's marker
         only where that direction carries a checksum)."""
         marker = self.marker if self.checksum is not None and direction in self.checksummed else ""
-        return "".join({self.start, self.response_start, self.separator, marker, *self.end} - {""})
+        ends = {*self.end, *self.response_end}
+        return "".join({self.start, self.response_start, self.separator, marker, *ends} - {""})
 
 
 # --- fields -------------------------------------------------------------------------------------------------------
@@ -667,7 +684,12 @@ def _decimal(spec: TextField, text: str) -> Fixed:
 
 
 def _integer(spec: TextField, text: str) -> int:
-    if not _unsigned(text).isdecimal():  # [+-]?\d+
+    digits = _unsigned(text)
+    if spec.base == 16:  # [+-]?[0-9A-Fa-f]+
+        if not digits or not set(digits) <= _HEX_DIGITS:
+            raise ValueError(text)
+        return int(text, 16)
+    if not digits.isdecimal():  # [+-]?\d+
         raise ValueError(text)
     return int(text)
 
@@ -726,6 +748,8 @@ def _looks(spec: TextField) -> str:
             return "one of " + ", ".join(str(m.value) for m in spec.letters)
         case "char":
             return "one character"
+        case "integer" if spec.base == 16:
+            return "an integer in hex digits"
         case "time":
             return "hhmmss[.ss]"
         case "date":
@@ -800,7 +824,8 @@ def _put_integer(spec: TextField, value: Any, where: str) -> str:
         raise EncodeError(f"{where} must be an integer, got {shown(value)}")
     _number(spec, value, where)
     sign = "-" if value < 0 else ""
-    return f"{sign}{abs(value):0{spec.width}d}"
+    form = "d" if spec.base != 16 else "x" if spec.lower else "X"
+    return f"{sign}{abs(value):0{spec.width}{form}}"
 
 
 def _put_angle(spec: TextField, value: Any, where: str) -> str:
@@ -914,13 +939,14 @@ def _field_text(sentence: TextSentence, name: str, given: Any) -> str:
     return given if isinstance(given, str) else str(given)
 
 
-def _ascii(frame: bytes | str, end: str = "") -> str:
+def _ascii(frame: bytes | str, end: str = "", other: str = "") -> str:
     """A frame's characters: ASCII, but for a line ending `end` that may hold bytes above 0x7F (Nextion's FF FF FF),
     each such byte a character of the same number."""
     if isinstance(frame, str):
         return frame
     text = bytes(frame).decode("latin-1")
-    body = text[: -len(end)] if end and text.endswith(end) else text
+    ending = max((e for e in (end, other) if e and text.endswith(e)), key=len, default="")
+    body = text[: len(text) - len(ending)]
     if bad := next((c for c in body if c > "\x7f"), None):
         raise DecodeError(f"text frame holds a non-ASCII byte {ord(bad):02X}")
     return text
@@ -943,7 +969,10 @@ class TextStreamParser:
         self._start = framing.start.encode("ascii")
         # every start a frame may have (one character each where the directions have their own)
         self._starts = tuple(s.encode("ascii") for s in dict.fromkeys((framing.start, framing.response_start)) if s)
-        self._end = framing.end.encode("latin-1")
+        # the line endings a frame of this stream may end with (each direction its own: the direction's, or both)
+        ends = (framing.end, framing.response_end) if direction is None else (framing.end_of(direction),)
+        self._ends = tuple(e.encode("latin-1") for e in dict.fromkeys(ends) if e)
+        self._end = max(self._ends, key=len)  # the longest (how far past max_length a frame may reach)
         self._buffer = b""
         self.corrupt = 0
         self.last_error = ""
@@ -960,7 +989,7 @@ class TextStreamParser:
                 self._buffer = self._buffer[-(len(self._start) - 1) :] if len(self._start) > 1 else b""
                 return found
             self._buffer = self._buffer[start:]
-            end = self._buffer.find(self._end, len(self._start))
+            end, size = self._find_end(len(self._start))
             restart = self._find_start(len(self._start))
             if end < 0 or (0 <= restart < end):
                 if restart >= 0 and (end < 0 or restart < end):
@@ -972,15 +1001,30 @@ class TextStreamParser:
                     self._buffer = self._buffer[len(self._start) :]
                     continue
                 return found
-            if end + len(self._end) - 1 > limit:  # it grew past max_length before its ending came: read in pieces,
+            if end + size - 1 > limit:  # it grew past max_length before its ending came: read in pieces,
                 self._dropped(f"no line ending within {self.framing.max_length} characters")  # it is dropped too
                 self._buffer = self._buffer[len(self._start) :]
                 continue
-            frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
+            frame, self._buffer = self._buffer[: end + size], self._buffer[end + size :]
             try:
                 found.append(self._decoded(frame))
             except DecodeError as error:
                 self._dropped(str(error))
+
+    def _find_end(self, at: int) -> tuple[int, int]:
+        """Where the first line ending at or after `at` is in the buffer and its size, or (-1, 0). With two (each
+        direction its own), the longest of those found first; none yet where the buffer stops inside a longer one
+        there (`\\r` then, maybe, `\\r>`)."""
+        if len(self._ends) == 1:
+            return self._buffer.find(self._end, at), len(self._end)
+        found = [(i, len(e)) for e in self._ends if (i := self._buffer.find(e, at)) >= 0]
+        if not found:
+            return -1, 0
+        end, size = min(found, key=lambda f: (f[0], -f[1]))
+        tail = self._buffer[end:]
+        if any(len(e) > max(size, len(tail)) and e.startswith(tail) for e in self._ends):
+            return -1, 0
+        return end, size
 
     def _find_start(self, at: int) -> int:
         """Where the first start at or after `at` is in the buffer, or -1."""
@@ -993,18 +1037,18 @@ class TextStreamParser:
         """Frames without a start character: each line is a frame. A line that grows past `max_length` is dropped
         to its end; an empty line (a device's CR LF where the spec says CR) is skipped."""
         while True:
-            end = self._buffer.find(self._end)
+            end, size = self._find_end(0)
             if end < 0:
                 if len(self._buffer) > limit:
                     self._dropped(f"no line ending within {self.framing.max_length} characters")
                     keep = len(self._end) - 1  # the start of a line ending split between reads
                     self._buffer, self._overlong = self._buffer[len(self._buffer) - keep :], True
                 return found
-            frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
+            frame, self._buffer = self._buffer[: end + size], self._buffer[end + size :]
             if self._overlong:  # the rest of a line already dropped
                 self._overlong = False
                 continue
-            if end + len(self._end) - 1 > limit:  # it grew past max_length before its ending came (whatever the reads)
+            if end + size - 1 > limit:  # it grew past max_length before its ending came (whatever the reads)
                 self._dropped(f"no line ending within {self.framing.max_length} characters")
                 continue
             if not frame[:end].strip():

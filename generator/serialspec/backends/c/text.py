@@ -300,6 +300,8 @@ const char *{p}_result_name(int result);
         match f.kind:
             case "decimal":
                 call = f"{self.call('get_decimal')}(c->b + s, len, &{target})"
+            case "integer" if f.base == 16:
+                call = f"{self.call('get_hex_integer')}(c->b + s, len, &{target})"
             case "integer":
                 call = f"{self.call('get_integer')}(c->b + s, len, &{target})"
             case "angle":
@@ -412,6 +414,8 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         match f.kind:
             case "decimal":
                 call = f"{self.call('put_decimal')}(o, &{v}, {v}.width)"
+            case "integer" if f.base == 16:
+                call = f"{self.call('put_hex_integer')}(o, {v}, {f.width}u, {int(f.lower)}u)"
             case "integer":
                 call = f"{self.call('put_integer')}(o, {v}, {f.width}u)"
             case "angle":

@@ -214,6 +214,40 @@ static int pfx__get_integer(const uint8_t *t, size_t n, int64_t *out)
         ("digit", "digits"),
     ),
     Piece(
+        r"""/* integer in hex digits, either case: [+-]?[0-9A-Fa-f]+ (at most 15 digits: PFX_E_CAPACITY beyond). */
+static int pfx__get_hex_integer(const uint8_t *t, size_t n, int64_t *out)
+{
+    size_t i = 0u, first;
+    int64_t v = 0;
+    if (n > 0u && (t[0] == 0x2Bu || t[0] == 0x2Du)) {
+        i = 1u;
+    }
+    first = i;
+    for (; i < n; i++) {
+        uint8_t c = t[i];
+        if (!((c >= 0x30u && c <= 0x39u) || (c >= 0x41u && c <= 0x46u) || (c >= 0x61u && c <= 0x66u))) {
+            return PFX_E_CONTENT;
+        }
+    }
+    if (n == first) {
+        return PFX_E_CONTENT;
+    }
+    if (n - first > 15u) {
+        return PFX_E_CAPACITY;
+    }
+    for (i = first; i < n; i++) {
+        uint8_t c = t[i];
+        v = v * 16 + (int64_t)(c <= 0x39u ? c - 0x30u : (c | 0x20u) - 0x57u);
+    }
+    *out = first == 1u && t[0] == 0x2Du ? -v : v;
+    return PFX_OK;
+}
+
+""",
+        "get_hex_integer",
+        (),
+    ),
+    Piece(
         r"""/* angle: 1..width digits of degrees, two of minutes, [.digits]; minutes below 60. */
 static int pfx__get_angle(const uint8_t *t, size_t n, unsigned width, pfx_angle_t *out)
 {
@@ -439,6 +473,34 @@ static void pfx__put_digits(pfx__out_t *o, uint64_t v, unsigned width)
 """,
         "put_integer",
         ("put", "put_digits", "magnitude"),
+    ),
+    Piece(
+        r"""/* integer in hex digits, zero-padded to width digits, upper case (lower: lower case). */
+static void pfx__put_hex_integer(pfx__out_t *o, int64_t v, unsigned width, unsigned lower)
+{
+    uint8_t d[16];
+    unsigned k = 0u;
+    uint64_t m = pfx__magnitude(v);
+    if (v < 0) {
+        pfx__put(o, 0x2Du);
+    }
+    do {
+        unsigned x = (unsigned)(m & 0xFu);
+        d[k++] = (uint8_t)(x < 10u ? 0x30u + x : (lower ? 0x57u : 0x37u) + x);
+        m >>= 4;
+    } while (m > 0u);
+    while (width > k) {
+        pfx__put(o, 0x30u);
+        width--;
+    }
+    while (k > 0u) {
+        pfx__put(o, d[--k]);
+    }
+}
+
+""",
+        "put_hex_integer",
+        ("put", "magnitude"),
     ),
     Piece(
         r"""static void pfx__put_decimal(pfx__out_t *o, const pfx_decimal_t *d, unsigned width)

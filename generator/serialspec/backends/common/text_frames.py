@@ -23,6 +23,10 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
     if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
         raise Unsupported("a text field to the end of the line (`size: rest`)")
+    if text.response_end:
+        raise Unsupported("a line ending of its own for each direction (`end: {request: ..., response: ...}`)")
+    if any(m.code != (text.request(m.key) or m).code for m in text.messages):
+        raise Unsupported("a reply under a code of its own (`text: {code: ...}`)")
     if any(m.layout is not None for m in text.messages):
         raise Unsupported("a message's own text layout (`text:`)")
     # (a target that reads each line alone: a line of values names no message)

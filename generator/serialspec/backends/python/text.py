@@ -167,6 +167,10 @@ def _descriptor(f: TextField) -> str:
         arguments.append("address=True")
     if f.rest:
         arguments.append("rest=True")
+    if f.base != 10:
+        arguments.append(f"base={f.base}")
+    if f.lower:
+        arguments.append("lower=True")
     return f"TextField({', '.join(arguments)})"
 
 
@@ -254,6 +258,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         yield f"    response_start={text.response_start!r},"
     yield f"    separator={text.separator!r},"
     yield f"    end={text.end!r},"
+    if text.response_end:
+        yield f"    response_end={text.response_end!r},"
     yield f"    checksum={checksum},"
     yield f"    marker={text.marker!r},"
     yield f"    digits={text.digits},"

@@ -244,7 +244,7 @@ def _text_example(package: ModuleType, text: TextFrame, example: TextExample) ->
         encoded = package.encode(message)
     except SerialspecError as exc:
         return f"its values do not encode: {exc}"
-    if encoded != (example.printed + text.end).encode("latin-1"):
+    if encoded != (example.printed + text.end_of(example.direction)).encode("latin-1"):
         return f"its values encode to {encoded!r}, not the frame"
     return ""
 

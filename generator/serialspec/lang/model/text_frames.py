@@ -29,6 +29,8 @@ class TextField:
     label: str = ""  # in a message with its own text layout (`named`): the label its value follows
     address: bool = False  # the framing's `address`: every message's first field, written before the code
     rest: bool = False  # text `size: rest`: the rest of the line, separators included (the last field)
+    base: Literal[10, 16] = 10  # integer: its digits' base (16: hex digits, an ELM327's `1A F8`)
+    lower: bool = False  # integer with base 16: hex digits written in lower case (`case: lower`)
 
 
 @frozen
@@ -67,7 +69,7 @@ class TextMessage:
     """One direction of a command in a text protocol: chosen by its text code."""
 
     key: str  # the command's name
-    code: str
+    code: str  # the code its frames carry: the command's, or its `text: {code}` (an ELM327's reply `41 0C`)
     title: str
     description: str
     direction: Direction
@@ -146,6 +148,11 @@ class TextFrame:
     checksum_separated: tuple[str, ...] = ()  # the directions that write the separator before the marker
     response_start: str = ""  # the responses' own start where it differs from the requests' (`start`): LSS's `*`
     address: TextField | None = None  # every message's first field, its digits before the code (LSS's servo id)
+    response_end: str = ""  # the responses' own line ending where it differs from the requests' (`end`): ELM327's
+
+    def end_of(self, direction: Direction) -> str:
+        """The line ending of a frame in `direction` (the requests' where the responses have none of their own)."""
+        return self.response_end if direction == Direction.RESPONSE and self.response_end else self.end
 
     def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
         """The command's message in `direction` (its response by default: what a device sends)."""
@@ -162,15 +169,16 @@ class TextFrame:
         return self.response(request.answered_by or request.key)
 
     def answers(self) -> dict[str, tuple[tuple[str, ...], ...]]:
-        """Each request code answered by another command (`answered_by`), refused by some (`refused_by`) or whose
-        answer ends with another's response (`then`) -> the codes of the responses that answer it, of those that
+        """Each request code answered by another command (`answered_by`) or under a code of its own (`text.code`),
+        refused by some (`refused_by`), or whose answer ends with another's response (`then`) -> the codes of the responses that answer it, of those that
         refuse it, and (with `then`) of the one that ends the answer."""
         codes = {m.key: m.code for m in self.messages if m.direction == Direction.RESPONSE}
         return {
             m.code: ((codes[m.answered_by or m.key],), tuple(codes[k] for k in m.refused_by))
             + (((codes[m.then],),) if m.then else ())
             for m in self.messages
-            if m.direction == Direction.REQUEST and (m.answered_by or m.refused_by or m.then)
+            if m.direction == Direction.REQUEST
+            and (m.answered_by or m.refused_by or m.then or codes.get(m.key, m.code) != m.code)
         }
 
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:

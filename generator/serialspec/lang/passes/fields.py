@@ -47,7 +47,7 @@ FIELD_KINDS = (
 
 
 # Keys of text fields (framing kind text) that a binary field must not have
-TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count", "label")
+TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count", "label", "base", "case")
 
 
 class FieldResolver(Pass):

@@ -36,7 +36,7 @@ KINDS = ("decimal", "integer", "angle", "char", "text", "time", "date")
 # Keys a text field may have, by kind (besides type, use, description, unit)
 KIND_KEYS = {
     "decimal": {"precision", "width", "range"},
-    "integer": {"width", "range"},
+    "integer": {"width", "range", "base", "case"},
     "angle": {"precision", "width", "range"},
     "char": {"letters"},
     "text": {"size"},
@@ -98,10 +98,13 @@ class TextPass(Pass):
                     if message is not None:
                         messages.append(message)
         codes: dict[str, TextMessage] = {}
-        for message in messages:  # a command's request and response share its code
+        commands = self.section("commands")
+        for message in messages:  # a command's request and response share its code, unless one has its own
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
-                self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+                own = message.code != (commands.get(message.key) or {}).get("code")
+                where: Path = ("commands", message.key, *((message.direction.value, "text") if own else ()), "code")
+                self.error(where, f"code {message.code!r} is also {other.key}'s")
         self.found_by_code(messages)
         responses = {m.key for m in messages if m.direction == Direction.RESPONSE}
         for message in messages:
@@ -143,6 +146,14 @@ class TextPass(Pass):
                 self.error((*path, "start"), "give each direction its own start, two different characters")
         # a separator or end missing or not text (said above, or by the grammar): stand-ins that clash with nothing,
         # so that no second line blames the characters of a value that is not there
+        ends = raw.get("end")
+        response_end = ""
+        if isinstance(ends, dict):  # one per direction: an ELM327's CR after a request, `\r\r>` after a reply
+            raw = {**raw, "end": str(ends.get("request") or "")}
+            response_end = str(ends.get("response") or "")
+            if not raw["end"] or not response_end or raw["end"] == response_end:
+                self.error((*path, "end"), "give each direction its own line ending, two different texts")
+                response_end = ""
         separator, end = (
             raw[k] if isinstance(raw.get(k), str) and raw[k] else stand_in
             for k, stand_in in (("separator", "\x1f"), ("end", "\x1e"))
@@ -178,9 +189,10 @@ class TextPass(Pass):
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
         if any(not " " <= c <= "~" for c in (start, response_start, separator) if c):
             self.error(path, "`start` and `separator` are printable ASCII characters")
-        if any(c > "\xff" for c in end):
+        if any(c > "\xff" for c in end + response_end):
             self.error((*path, "end"), "the line ending's characters are bytes: U+0000 to U+00FF (Nextion: \\xFF)")
-        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *set(end)]
+        ending = set(end) | set(response_end)
+        special = [*([start] if start else []), *([response_start] if response_start else []), separator, *ending]
         special += [marker] if algorithm is not None else []
         if len(set(special)) != len(special):
             self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
@@ -202,6 +214,7 @@ class TextPass(Pass):
             checksum_separated=separated,
             response_start=response_start,
             address=self.address(raw["address"]) if "address" in raw else None,
+            response_end=response_end,
         )
 
     def address(self, name: Any) -> TextField | None:
@@ -218,6 +231,8 @@ class TextPass(Pass):
             return None
         if found.minimum is not None and found.minimum < 0:
             self.error(path, f"the address {name!r} is written as digits alone: its range starts at 0 or above")
+        if found.base != 10:
+            self.error(path, f"the address {name!r} is read as the decimal digits before the code: not `base: 16`")
         return replace(found, address=True)
 
     def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
@@ -228,7 +243,7 @@ class TextPass(Pass):
         code = command.get("code")
         # the framing's own characters would cut the code out of its frame (`$` starts NMEA sentences)
         framing = (
-            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end} - {""}
+            {frame.start, frame.response_start, frame.separator, frame.marker, *frame.end, *frame.response_end} - {""}
             if frame is not None
             else set()
         )
@@ -262,6 +277,8 @@ class TextPass(Pass):
             if any(item.name == frame.address.name for item in fields):
                 self.error((*where, "fields", frame.address.name), "the framing's `address` is every message's already")
             fields = (frame.address, *fields)
+        if isinstance(raw.get("text"), dict) and "code" in raw["text"]:  # a code of its own: ELM327's reply `41 0C`
+            code = self.own_code(raw["text"], (*where, "text"), frame, allowed) or code
         layout = (
             self.layout(raw["text"], code, fields, (*where, "text"), frame)
             if "text" in raw and isinstance(raw["text"], dict)
@@ -299,6 +316,22 @@ class TextPass(Pass):
             values_only=values_only,
         )
 
+    def own_code(self, raw: dict[str, Any], path: Path, frame: TextFrame | None, allowed: set[str]) -> str:
+        """A message's code of its own (`text: {code}`): a code's characters, and the message's separator between
+        words where it has no `start` of its own (it is found by the code at the start of the frame). "" where it
+        is not one (said): the message keeps its command's, so that nothing else about it is reported again."""
+        code = raw["code"]
+        separator = str(raw.get("separator", frame.separator if frame is not None else ","))
+        words = code.split(separator) if isinstance(code, str) and separator and not raw.get("start") else [code]
+        if not isinstance(code, str) or not all(w and set(w) <= allowed for w in words):
+            shown = "".join(sorted(set(CODE_PUNCTUATION) & allowed))
+            between = f", words between single {separator!r}" if separator and not raw.get("start") else ""
+            if raw.get("start") and isinstance(code, str) and separator and separator in code:
+                between = f" (words between {separator!r} only in a message found by its code: no `start`)"
+            self.error((*path, "code"), f"a text code is letters, digits and {shown}{between}; got {code!r}")
+            return ""
+        return code
+
     def found_by_code(self, messages: list[TextMessage]) -> None:
         """Each message found by its code alone (its own text without a `start`) is told from every other code: the
         code and what follows it (`after_code`, else the separator) begin no other code, unless the code is glued
@@ -311,7 +344,8 @@ class TextPass(Pass):
             after = layout.separator if layout.after_code is None else layout.after_code
             sent = [f for f in message.fields if not (isinstance(f, TextField) and f.address)]
             first = sent[0] if sent else None
-            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal")
+            # a decimal number (hex digits could go on as another code's letters)
+            numeric = isinstance(first, TextField) and first.kind in ("integer", "decimal") and first.base == 10
             for other in sorted(codes):
                 if other == message.code or not other.startswith(message.code + after):
                     continue
@@ -333,7 +367,11 @@ class TextPass(Pass):
         frame: TextFrame | None,
     ) -> TextLayout:
         """A message's own `text:` layout, checked against the framing's characters, its code and its fields."""
-        framing = {frame.start, frame.response_start, frame.marker, *frame.end} - {""} if frame is not None else set()
+        framing = (
+            {frame.start, frame.response_start, frame.marker, *frame.end, *frame.response_end} - {""}
+            if frame is not None
+            else set()
+        )
         given = {k: str(raw[k]) for k in ("start", "end", "separator", "named", "list", "after_code") if k in raw}
         given.setdefault("separator", frame.separator if frame is not None else ",")
         glued = given.get("named") == ""  # labels glued to their values: G-code's `X10.5`, LSS's `D1800T1500`
@@ -354,7 +392,7 @@ class TextPass(Pass):
             self.error(path, "`separator`, `named` and `list` differ from each other and from the framing's characters")
         if set(layout.after_code or "") & framing:
             self.error((*path, "after_code"), "`after_code` differs from the framing's characters")
-        if set(code) & set(single + [layout.after_code or ""]) - {""}:
+        if set(code) & set(single + [layout.after_code or ""]) - {"", "" if layout.start else layout.separator}:
             self.error(path, f"the code {code!r} holds one of the message's own characters")
         if not layout.start and not glued and any(item.label == code for item in fields):
             self.error(path, "a field labelled with the code needs the message's own `start`")
@@ -388,8 +426,10 @@ class TextPass(Pass):
             where = (*path[:-1], "fields", item.name)
             if isinstance(item, TextRepeat):
                 self.error(where, 'a repeat in a message whose labels are glued to their values (`named: ""`)')
-            elif not layout.separator and item.kind not in ("integer", "decimal"):
-                self.error(where, "without a separator, a value glued between labels is a number (integer, decimal)")
+            elif not layout.separator and (item.kind not in ("integer", "decimal") or item.base != 10):
+                self.error(
+                    where, "without a separator, a value glued between labels is a decimal number (integer, decimal)"
+                )
         for label in labels:
             if any(other != label and other.startswith(label) for other in labels):
                 self.error((*path[:-1], "fields"), f"label {label!r} begins another label: a value could follow either")
@@ -476,7 +516,15 @@ class TextPass(Pass):
             letters_class=letters_class,
             label=str(spec.get("label", "")),
             rest=self.rest(spec, path, top),
+            base=16 if spec.get("base") == 16 else 10,
+            lower=self.lower(spec, path),
         )
+
+    def lower(self, spec: dict[str, Any], path: Path) -> bool:
+        """`case: lower` (hex digits written in lower case), which only an integer of `base: 16` has."""
+        if "case" in spec and spec.get("base") != 16:
+            self.error((*path, "case"), "`case` is that of hex digits: it needs `base: 16`")
+        return spec.get("case") == "lower"
 
     def rest(self, spec: dict[str, Any], path: Path, top: bool) -> bool:
         """A text field's `size: rest`: the rest of the line, separators included (the last field of a message)."""

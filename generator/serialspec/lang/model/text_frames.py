@@ -170,8 +170,8 @@ class TextFrame:
 
     def answers(self) -> dict[str, tuple[tuple[str, ...], ...]]:
         """Each request code answered by another command (`answered_by`) or under a code of its own (`text.code`),
-        refused by some (`refused_by`), or whose answer ends with another's response (`then`) -> the codes of the responses that answer it, of those that
-        refuse it, and (with `then`) of the one that ends the answer."""
+        refused by some (`refused_by`), or whose answer ends with another's response (`then`) -> the codes of the
+        responses that answer it, of those that refuse it, and (with `then`) of the one that ends the answer."""
         codes = {m.key: m.code for m in self.messages if m.direction == Direction.RESPONSE}
         return {
             m.code: ((codes[m.answered_by or m.key],), tuple(codes[k] for k in m.refused_by))

@@ -1,6 +1,7 @@
-"""A text request whose answer ends with another command's response (`answered_by: {then: ...}`): an AT-command
-module (HC-05 style) answers `AT+VERSION?` with `+VERSION:...` and then `OK`. The client returns the reply once the
-`OK` has come too, so the next request does not take that `OK` for its own answer; the simulator sends both."""
+"""What AT-command modules do to a text client. A request whose answer ends with another command's response
+(`answered_by: {then: ...}`): an HC-05 style module answers `AT+VERSION?` with `+VERSION:...` and then `OK`; the
+client returns the reply once the `OK` has come too, so the next request does not take that `OK` for its own answer;
+the simulator sends both. A device that echoes each line (`echo=True`): the echo is never the reply."""
 
 from __future__ import annotations
 
@@ -143,3 +144,50 @@ def test_a_binary_spec_is_told_then_is_for_text_frames(tmp_path: Path) -> None:
         load_protocol(path)
     lines = str(caught.value).splitlines()
     assert len(lines) == 1 and "answered_by.then: `then` is for text frames" in lines[0], lines
+
+
+ECHOED = """
+protocol: echoing
+title: A supply that echoes each line (echo on)
+serial: {baudrate: 9600}
+framing: {kind: text, separator: "=", end: "\\r\\n"}
+commands:
+  set_voltage:
+    code: SV
+    request: {fields: {volts: {type: decimal, precision: 2, range: [0, 30]}}}
+    response: {fields: {volts: {type: decimal, precision: 2, range: [0, 30]}}}
+device:
+  state: {supply: 5}
+  commands:
+    set_voltage: {reports: {volts: supply}}
+"""
+
+
+def test_a_device_that_echoes_each_line(tmp_path: Path) -> None:
+    """A request and its reply written alike (`SV=12.00` answered by `SV=5.00`, the voltage set): with the device
+    echoing each line, `echo=True` takes the echo out, and the reply is the device's; without it the echo itself
+    would be read as the reply. An echo that differs from the line written is a PortError."""
+    from conftest import generate_and_import
+    from pty_pair import answering_line
+    from serialspec.runtime.errors import PortError
+
+    path = tmp_path / "echoing.yaml"
+    path.write_text(ECHOED, "utf-8")
+    echoing = generate_and_import(path, tmp_path / "out", "echoing")
+    simulator = importlib.import_module("echoing.simulator").SIMULATOR()
+    simulator.echo = True
+    try:
+        with echoing.Client(simulator.start(), echo=True) as client:
+            assert float(client.set_voltage(12, timeout=5).volts) == 5.0
+            assert float(client.set_voltage(7, timeout=5).volts) == 5.0
+            assert client.read(0.3) == []
+    finally:
+        simulator.close()
+        for name in [m for m in sys.modules if m.partition(".")[0] == "echoing"]:
+            del sys.modules[name]
+    with (
+        answering_line(b"SV=12.00\r\n", b"SV=13.00\r\nSV=5.00\r\n") as name,
+        echoing.Client(name, echo=True) as client,
+        pytest.raises(PortError, match="the echo differs from the line written"),
+    ):
+        client.set_voltage(12, timeout=1)

@@ -1234,12 +1234,16 @@ class TextClient:
     """A text device on a serial port (a path, any URL pyserial opens, or an open port): the messages it sends on
     its own, by iteration (`for message in client`, or `messages(timeout)`), and by callbacks subscribed with
     `on(callback, *types)`, called as the messages are read. `send` writes a message. Generated packages bind
-    `CODEC` and `SERIAL` in their `Client`."""
+    `CODEC` and `SERIAL` in their `Client`.
+
+    `echo=True`: the device (or a one-wire adapter) sends every line written back before its answer (an AT module
+    or an ELM327 with echo on, ATE1): the client takes the echo out of what it reads, so a request read back is
+    never taken for its reply, and an echo that differs from the line written is a PortError."""
 
     CODEC: ClassVar[TextCodec]
     SERIAL: ClassVar[Any]
 
-    def __init__(self, port: Any, *, baudrate: int | None = None) -> None:
+    def __init__(self, port: Any, *, baudrate: int | None = None, echo: bool = False) -> None:
         from serialspec.runtime.transport import _PARITY, link
 
         if isinstance(port, str):
@@ -1259,6 +1263,8 @@ class TextClient:
         self.parser = TextMessageParser(self.CODEC, "response")
         self._callbacks: list[tuple[Callable[[Any], None], tuple[type, ...]]] = []
         self._unread: list[Any] = []  # messages read while waiting for an answer, for `messages()` and `read()`
+        self.echo = echo
+        self._echoed = b""  # with echo: the bytes written whose echo has not all come back yet
 
     def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
         """Call `callback(message)` for every message read (of these types; none given: all); returns a function
@@ -1353,6 +1359,17 @@ class TextClient:
             self.parser.expect(None)
 
     def _arrived(self, data: bytes) -> list[Any]:
+        if self._echoed and data:  # the echo of what was written comes first: take it out
+            from serialspec.runtime.errors import PortError
+
+            take = min(len(data), len(self._echoed))
+            if data[:take] != self._echoed[:take]:
+                written, self._echoed = self._echoed, b""
+                raise PortError(
+                    f"{getattr(self.port, 'port', None) or 'the port'}: the echo differs from the line written: "
+                    f"wrote {written!r}, read back {data[:take]!r}; is echo=True right for this device?"
+                )
+            data, self._echoed = data[take:], self._echoed[take:]
         messages = self.parser.feed(data)
         for message in messages:
             for callback, types in list(self._callbacks):
@@ -1362,7 +1379,10 @@ class TextClient:
 
     def send(self, message: TextRecord) -> None:
         """Write one message (range checks first: nothing is written when a value is refused)."""
-        self._link.write(self.CODEC.encode(message))
+        frame = self.CODEC.encode(message)
+        self._link.write(frame)
+        if self.echo:
+            self._echoed += frame
 
     def close(self) -> None:
         self.port.close()
@@ -1382,9 +1402,9 @@ class AsyncTextClient:
     CODEC: ClassVar[TextCodec]
     SERIAL: ClassVar[Any]
 
-    def __init__(self, port: Any, *, baudrate: int | None = None) -> None:
+    def __init__(self, port: Any, *, baudrate: int | None = None, echo: bool = False) -> None:
         bound = type("Client", (TextClient,), {"CODEC": self.CODEC, "SERIAL": self.SERIAL})
-        self.sync: TextClient = bound(port, baudrate=baudrate)
+        self.sync: TextClient = bound(port, baudrate=baudrate, echo=echo)
 
     def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
         """`TextClient.on`: call `callback(message)` for every message read (of these types)."""

@@ -392,7 +392,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
 
 
 #: TextClient's own names: a command of one of these names gets a method with `_` after it.
-CLIENT_NAMES = frozenset({"on", "read", "messages", "request", "send", "close", "port", "parser"})
+CLIENT_NAMES = frozenset({"on", "read", "messages", "request", "send", "close", "port", "parser", "echo"})
 
 
 def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:

@@ -2036,10 +2036,12 @@ def test_a_reply_of_values_alone_through_every_output() -> None:
         assert both.feed(package.encode(asked) + frame) == [asked, answer]
 
 
-def test_an_answer_ended_by_another_line_through_every_output(tmp_path: Path) -> None:
-    """`answered_by: {command, then}` on a text request (an AT command's reply line, then its `OK`): every output
-    takes the spec (the C and the dissector read each line alone, as before; the C compiles clean), the reference
-    says which line ends the answer, and the simulator sends the reply and then that line."""
+@pytest.mark.parametrize("many", [False, True])
+def test_an_answer_ended_by_another_line_through_every_output(many: bool, tmp_path: Path) -> None:
+    """`answered_by: {command, then}` on a text request (an AT command's reply line, then its `OK`), with `many`
+    (the reply any number of times) and without: every output takes the spec (the C and the dissector read each line
+    alone, as before; the C compiles clean), the reference says which line ends the answer, the client's method
+    returns the reply (`many`: a tuple of them), and the simulator sends the reply and then that line."""
     from serialspec.backends import emit
 
     case = copy.deepcopy(TEXT_CASE)
@@ -2048,7 +2050,7 @@ def test_an_answer_ended_by_another_line_through_every_output(tmp_path: Path) ->
         "title": "Asked for the dial's reply, the answer ended by OK",
         "request": {
             "fields": {"level": {"type": "integer", "range": [0, 99]}, "note": "text"},
-            "answered_by": {"command": "dial", "then": "answer"},
+            "answered_by": {"command": "dial", "then": "answer", "many": many},
         },
     }
     case["device"]["commands"]["ask"] = case["device"]["commands"]["dial"]
@@ -2062,6 +2064,8 @@ def test_an_answer_ended_by_another_line_through_every_output(tmp_path: Path) ->
         assert emitter.verify is None or emitter.verify(protocol, emitted) == []
         files.update(emitted)
     assert "then the `answer` response, which ends the answer" in files["docs/matrix_text.md"]
+    returned = "tuple[DialResponse, ...]" if many else "DialResponse"
+    assert f"timeout: float = 1.0) -> {returned}:" in files["matrix_text/__init__.py"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         assert package.CODEC.final("AS") is package.AnswerResponse and package.CODEC.final("DL") is None

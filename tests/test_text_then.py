@@ -45,9 +45,18 @@ commands:
   reset:
     code: "AT+RESET"
     request: {answered_by: {command: ok, refused_by: [error]}}
+  access_point:
+    code: "+CWLAP"
+    response:
+      unsolicited: true
+      fields:
+        ssid: {type: text}
+  list_access_points:
+    code: "AT+CWLAP"
+    request: {answered_by: {command: access_point, then: ok, many: true, refused_by: [error]}}
 device:
   state: {}
-  reply: {version: "2.0-20100601"}
+  reply: {version: "2.0-20100601", ssid: lab}
 """
 
 
@@ -88,6 +97,28 @@ def test_the_client_waits_for_the_ok_and_the_next_request_gets_its_own(module: M
 
 
 @pytest.mark.parametrize(
+    ("answer", "ssids"),
+    [(b"+CWLAP:lab\r\n+CWLAP:office\r\nOK\r\n", ["lab", "office"]), (b"OK\r\n", []), (None, ["lab"])],
+)
+def test_a_reply_any_number_of_times_before_the_end(module: ModuleType, answer: bytes | None, ssids: list[str]) -> None:
+    """`many: true`: the method returns every `+CWLAP` line before the `OK` (none when the `OK` comes at once; the
+    simulator sends one)."""
+    from pty_pair import answering_line
+
+    if answer is None:
+        simulator = importlib.import_module("atmodule.simulator").SIMULATOR()
+        try:
+            with module.Client(simulator.start()) as client:
+                found = client.list_access_points(timeout=5)
+        finally:
+            simulator.close()
+    else:
+        with answering_line(b"AT+CWLAP\r\n", answer) as name, module.Client(name) as client:
+            found = client.list_access_points(timeout=2)
+    assert isinstance(found, tuple) and [ap.ssid for ap in found] == ssids
+
+
+@pytest.mark.parametrize(
     ("answer", "raised"),
     [
         (b"ERROR:29\r\n", r"^version \(AT\+VERSION\?\): the device refused it"),
@@ -117,11 +148,13 @@ def test_a_refusal_an_answer_without_its_reply_or_without_its_end(
         ("okay", "commands.version.request.answered_by.then: 'okay' is not a command with a response"),
         ("version_info", "commands.version.request.answered_by.then: 'version_info' is the reply or a refusal"),
         ("error", "commands.version.request.answered_by.then: 'error' is the reply or a refusal"),
+        ("", "commands.version.request.answered_by.many: `many` needs `then`: the response that ends the replies"),
     ],
 )
 def test_then_mistakes_are_one_line_each(tmp_path: Path, then: str, said: str) -> None:
     path = tmp_path / "atmodule.yaml"
-    path.write_text(SPEC.replace("then: ok,", f"then: {then},"), "utf-8")
+    mistake = f"then: {then}," if then else "many: true,"
+    path.write_text(SPEC.replace("then: ok,", mistake, 1), "utf-8")
     with pytest.raises(SpecErrors) as caught:
         load_protocol(path)
     lines = str(caught.value).splitlines()
@@ -143,7 +176,7 @@ def test_a_binary_spec_is_told_then_is_for_text_frames(tmp_path: Path) -> None:
     with pytest.raises(SpecErrors) as caught:
         load_protocol(path)
     lines = str(caught.value).splitlines()
-    assert len(lines) == 1 and "answered_by.then: `then` is for text frames" in lines[0], lines
+    assert len(lines) == 1 and "answered_by.then: `then` and `many` are for text frames" in lines[0], lines
 
 
 ECHOED = """

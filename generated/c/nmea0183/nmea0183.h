@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "330a991fe0ea76a006a60146fbfbf2fb4eafd6fb986f3ef919f733451f42f204"
+#define NMEA0183_SPEC_SHA256 "90f82ff860d8e4ec1377c902be50de426f871664f2357cc0b9b4c70f8d8d4c7d"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

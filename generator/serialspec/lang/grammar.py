@@ -768,6 +768,13 @@ MESSAGE = Obj(
                     "each reply that is not a refusal.",
                     example="ok",
                 ),
+                "many": Bool(
+                    "Text frames, with `then`: the reply comes any number of times, a line each, before the `then` "
+                    "response (an AT module's `+CWLAP:` line per access point, then `OK`). The client's method "
+                    "returns the tuple of them, in order (empty when the device ends the answer at once).",
+                    default=False,
+                    example=True,
+                ),
                 "optional_when": OPTIONAL_WHEN,
             },
             description="For a request: answered by another command's response (FEETECH's one status packet; in text "

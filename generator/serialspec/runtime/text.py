@@ -1288,6 +1288,15 @@ class TextClient:
         self.send(message)
         return drive(self._answer(message, timeout), self._link.read)
 
+    def request_many(self, message: TextRecord, timeout: float = 1.0) -> tuple[Any, ...]:
+        """Send a request whose reply comes any number of times (`answered_by: {many: true}`) and return the
+        replies that came before the line that ends the answer (`then`), in order; Timeout when that line does not
+        come within `timeout` seconds, DeviceError for a refusal."""
+        from serialspec.runtime.transport import drive
+
+        self.send(message)
+        return drive(self._answer(message, timeout, many=True), self._link.read)
+
     def messages(self, timeout: float | None = None) -> Iterator[Any]:
         """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""
         import time
@@ -1314,7 +1323,9 @@ class TextClient:
             return unread
         return self._arrived((yield timeout))
 
-    def _answer(self, message: TextRecord, timeout: float) -> Generator[float, bytes, Any]:
+    def _answer(self, message: TextRecord, timeout: float, many: bool = False) -> Generator[float, bytes, Any]:
+        """The answer to a request just sent; `many` (a request whose reply comes any number of times before the
+        line that ends the answer: `answered_by: {many: true}`): the tuple of them."""
         import time
 
         from serialspec.runtime.errors import DeviceError, Timeout
@@ -1325,11 +1336,14 @@ class TextClient:
         final = self.CODEC.final(message.CODE)  # the response that ends the answer, after the reply (`then`)
         self.parser.expect(self.CODEC.reply_code(message.CODE))  # a reply of values alone is read as the answer
         answer = None
+        replies: list[Any] = []
         try:
             deadline = time.monotonic() + timeout
             while (left := deadline - time.monotonic()) > 0:
                 for arrived in self._arrived((yield min(left, 0.2))):
-                    if answer is None and isinstance(arrived, answers):
+                    if many and final is not None and isinstance(arrived, answers):
+                        replies.append(arrived)  # one more reply line, until the one that ends them
+                    elif answer is None and isinstance(arrived, answers):
                         if final is None:
                             return arrived
                         answer = arrived  # the answer goes on to its final response
@@ -1339,6 +1353,8 @@ class TextClient:
                             f"{message.COMMAND} ({message.CODE}): the device refused it: {arrived!r}", arrived
                         )
                     elif final is not None and isinstance(arrived, final):
+                        if many:
+                            return tuple(replies)
                         if answer is None:
                             raise DeviceError(
                                 f"{message.COMMAND} ({message.CODE}): the device ended its answer ({arrived!r}) "
@@ -1421,6 +1437,13 @@ class AsyncTextClient:
 
         await self.send(message)
         return await drive(self.sync._answer(message, timeout), self._wait)
+
+    async def request_many(self, message: TextRecord, timeout: float = 1.0) -> tuple[Any, ...]:
+        """`TextClient.request_many`, awaited."""
+        from serialspec.runtime.aio import drive
+
+        await self.send(message)
+        return await drive(self.sync._answer(message, timeout, many=True), self._wait)
 
     async def messages(self, timeout: float | None = None) -> AsyncIterator[Any]:
         """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""

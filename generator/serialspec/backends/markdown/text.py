@@ -188,7 +188,8 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         if message.answered_by:
             sent += f", answered by the `{message.answered_by}` response"
         if message.then:
-            sent += f", then the `{message.then}` response, which ends the answer"
+            several = " (the reply any number of times before it)" if message.many else ""
+            sent += f", then the `{message.then}` response, which ends the answer{several}"
         if message.refused_by:
             sent += f", refused by {' or '.join(f'the `{name}` response' for name in message.refused_by)}"
         request = frame.request(message.key)

@@ -392,7 +392,9 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
 
 
 #: TextClient's own names: a command of one of these names gets a method with `_` after it.
-CLIENT_NAMES = frozenset({"on", "read", "messages", "request", "send", "close", "port", "parser", "echo"})
+CLIENT_NAMES = frozenset(
+    {"on", "read", "messages", "request", "request_many", "send", "close", "port", "parser", "echo"}
+)
 
 
 def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:
@@ -411,13 +413,16 @@ def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:
             else:
                 params.append(f"{item.name}: {_annotation(item)} = None")
         returns = response.class_name if response is not None else "None"
+        if response is not None and request.many:  # every reply line before the one that ends the answer
+            returns = f"tuple[{returns}, ...]"
         yield ""
         yield f"    {define} {name}(self, {''.join(p + ', ' for p in params)}*, timeout: float = 1.0) -> {returns}:"
         title = one_line(request.title or request.key)
         answer = "and returns the answer" if response is not None else "(the device does not answer)"
         yield f'        """{request.code}: {title.rstrip(".")}. Sends the request {answer}."""'
         values = ", ".join(f"{item.name}={item.name}" for item in request.fields)
-        call = f"{wait}self.request({request.class_name}({values}), timeout)"
+        asked = "request_many" if request.many else "request"
+        call = f"{wait}self.{asked}({request.class_name}({values}), timeout)"
         if response is None:
             yield f"        {wait}self.send({request.class_name}({values}))"
         else:

@@ -80,6 +80,7 @@ class TextMessage:
     answered_by: str = ""  # a request answered by another command's response (its key): GRBL's `ok`
     refused_by: tuple[str, ...] = ()  # commands whose responses refuse the request instead: GRBL's `error:N`
     then: str = ""  # a request: the command whose response ends its answer, after the reply (an AT command's `OK`)
+    many: bool = False  # with `then`: the reply comes any number of times before it (AT+CWLAP's access points)
     layout: TextLayout | None = None  # its own text inside the frame (`text:`): GRBL's `<Idle|MPos:…>`
     values_only: bool = False  # a reply of its values alone, no code: read as the answer to the request before it
 

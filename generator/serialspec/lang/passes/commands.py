@@ -698,10 +698,10 @@ class Commands(FieldResolver):
                     self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
         if answered_by and direction != Direction.REQUEST:
             self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
-        if answered_by.get("then"):
+        if answered_by.get("then") or answered_by.get("many"):
             self.error(
-                (*path, "answered_by", "then"),
-                "`then` is for text frames; a binary reply that follows another is matched by its content "
+                (*path, "answered_by", "then" if answered_by.get("then") else "many"),
+                "`then` and `many` are for text frames; a binary reply that follows another is matched by its content "
                 "(`request_code`) or sent on its own (`device.sends` with `after`)",
             )
         if value.get("error_reply") and direction != Direction.RESPONSE:

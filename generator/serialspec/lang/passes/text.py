@@ -116,6 +116,8 @@ class TextPass(Pass):
                     self.error((*asked, "refused_by", index), f"{name!r} is not a command with a response")
                 elif name == message.answered_by:
                     self.error((*asked, "refused_by", index), f"{name!r} is the reply that answers it")
+            if message.many and not message.then:
+                self.error((*asked, "many"), "`many` needs `then`: the response that ends the replies")
             if message.then and message.then not in responses:
                 self.error((*asked, "then"), f"{message.then!r} is not a command with a response")
             elif message.then and message.then in (message.answered_by or message.key, *message.refused_by):
@@ -312,6 +314,7 @@ class TextPass(Pass):
             answered_by=str(answered_by.get("command", "")),
             refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
             then=str(answered_by.get("then", "")),
+            many=bool(answered_by.get("many", False)),
             layout=layout,
             values_only=values_only,
         )

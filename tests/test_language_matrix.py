@@ -251,6 +251,25 @@ CASES: dict[str, Case] = {
             "text": {"type": "string", "size": "rest", "encoding": "seven_bit"},
         }
     ),
+    # integers in as many bytes as they need: LEB128 (protobuf), zigzag, Kangaroo's 6 bits a byte with the sign in bit
+    # 0, MIDI's highest group first; a fixed field after them and bytes to the end
+    "encoding: varint": same(
+        {
+            "a": {"type": "u32", "encoding": "varint"},
+            "z": {"type": "i64", "encoding": "varint", "varint": {"sign": "zigzag"}},
+            "k": {
+                "type": "i32",
+                "encoding": "varint",
+                "varint": {"bits": 6, "sign": "low_bit"},
+                "range": [-100000, 100000],
+                "default": 5,
+                "unit": "mm",
+            },
+            "m": {"type": "u32", "encoding": "varint", "varint": {"order": "high_first"}, "range": [0, 0x0FFFFFFF]},
+            "w": "u16",
+            "tail": {"type": "bytes", "size": "rest"},
+        }
+    ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
     # bit fields (uN/iN of any width) packed MSB first into runs of whole bytes, every integer key on them, a
     # byte-sized integer inside an open run, a run in a group's items; in RTCM 3's frame: a 10-bit length after 6

@@ -463,9 +463,13 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
     "varint": Obj(
         {
-            "bits": Int("Value bits a byte; the bit above them marks more bytes.", default=7, minimum=1, maximum=7),
-            "order": Str("Which group comes first.", choices=varint.ORDERS, default="low_first"),
-            "sign": Str("How a signed value is sent (a signed type needs one).", choices=varint.SIGNS),
+            "bits": Int(
+                "Value bits a byte; the bit above them marks more bytes.", default=7, minimum=1, maximum=7, example=6
+            ),
+            "order": Str("Which group comes first.", choices=varint.ORDERS, default="low_first", example="high_first"),
+            "sign": Str(
+                "How a signed value is sent (a signed type needs one).", choices=varint.SIGNS, example="zigzag"
+            ),
         },
         description=varint.KEY_DOC,
     ),

@@ -34,7 +34,7 @@ from hypothesis import strategies as st
 from serialspec import cli
 from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
-from serialspec.encodings import bit_run
+from serialspec.encodings import bit_run, varint
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
 from serialspec.lang.model import (
@@ -1425,6 +1425,16 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
     assert {"u8", "u16", "u24", "u4"} - used["element type"] == set()
     assert any(bit_run.width(t) for t in used["type"])  # a bit field (uN/iN of another width)
+    forms = [  # every varint form: each sign, each order, another width than 7 bits
+        spec["varint"]
+        for case in CASES.values()
+        for fields in (case.request, case.response)
+        for spec in fields.values()
+        if isinstance(spec, dict) and "varint" in spec
+    ]
+    assert set(varint.SIGNS) <= {form.get("sign") for form in forms}
+    assert set(varint.ORDERS) <= {form.get("order", "low_first") for form in forms}
+    assert any(form.get("bits", 7) != 7 for form in forms)
     assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
 
 

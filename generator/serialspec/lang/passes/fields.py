@@ -135,7 +135,9 @@ class FieldResolver(Pass):
                         f"field (`size: {field.name}`), which encode then writes",
                     )
                 integer = isinstance(other, Scalar) and not other.type.is_float
-                if isinstance(node, expression.Name) and other is not None and not integer:
+                if isinstance(node, expression.Name) and isinstance(other, Varint):
+                    self.error(where, f"{node.name} is a varint: a `value:` names fixed-size integer fields")
+                elif isinstance(node, expression.Name) and other is not None and not integer:
                     self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")
                 elif isinstance(node, expression.Name) and isinstance(other, Scalar) and other.bits:
                     # its message value is the bit fields, not a number: encode could not compute the expression

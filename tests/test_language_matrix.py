@@ -252,8 +252,8 @@ CASES: dict[str, Case] = {
         }
     ),
     # integers in as many bytes as they need: LEB128 (protobuf), zigzag, Kangaroo's 6 bits a byte with the sign in bit
-    # 0, MIDI's highest group first; a fixed field after them and bytes to the end
-    "encoding: varint": same(
+    # 0, MIDI's highest group first; a fixed field after them and bytes to the end; the reply's in a group's items
+    "encoding: varint": Case(
         {
             "a": {"type": "u32", "encoding": "varint"},
             "z": {"type": "i64", "encoding": "varint", "varint": {"sign": "zigzag"}},
@@ -268,7 +268,15 @@ CASES: dict[str, Case] = {
             "m": {"type": "u32", "encoding": "varint", "varint": {"order": "high_first"}, "range": [0, 0x0FFFFFFF]},
             "w": "u16",
             "tail": {"type": "bytes", "size": "rest"},
-        }
+        },
+        {  # a signed varint only in a group's items
+            "w": "u8",
+            "g": {
+                "type": "group",
+                "count": "rest",
+                "fields": {"x": {"type": "i16", "encoding": "varint", "varint": {"sign": "zigzag"}}, "y": "u8"},
+            },
+        },
     ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
     # bit fields (uN/iN of any width) packed MSB first into runs of whole bytes, every integer key on them, a

@@ -111,7 +111,6 @@ commands:
         ("encoding: varint, ", "", "`varint` goes with `encoding: varint`"),
         ("{sign: zigzag}}", "{sign: zigzag}, scale: 0.1}", "`scale` does not go with encoding varint"),
         ("{sign: zigzag}}", "{sign: zigzag}, range: [0, 3000000000]}", "does not fit i32"),
-        ("n: u8\n", "n: {type: group, count: 2, fields: {w: {type: u8, encoding: varint}}}\n", "in a group's items"),
         ("zigzag}}\n", 'zigzag}}\n        i: {type: array, of: u8, count: "v % 4"}\n', "'v' in 'v % 4' is a varint"),
         ("zigzag}}\n", 'zigzag}}\n        d: {type: u8, value: "v + 1"}\n', "v is a varint: a `value:` names"),
         ("    length: {role: length, type: u8}\n", "", "a varint cannot size a frame that has no length element"),

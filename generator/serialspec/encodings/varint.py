@@ -40,7 +40,8 @@ KEY_DOC = (
     "needs one, an unsigned type takes none): zigzag (protobuf sint: 0, -1, 1, -2 sent as 0, 1, 2, 3) or low_bit "
     "(the magnitude shifted left once, the sign in bit 0: Dimension Engineering Kangaroo, `{type: i32, encoding: "
     "varint, varint: {bits: 6, sign: low_bit}}` sends 1000 as 50 1F and -1 as 03). The field's type gives the range; "
-    "decoding refuses more bytes than its widest value needs. Not a count or size, not in a group's items."
+    "decoding refuses more bytes than its widest value needs. Not a count or size; in a group's items too (a "
+    "protobuf packed list: a group of `count: rest`)."
 )
 #: The language reference's example: (label, fields, what it shows).
 VARIANT = (
@@ -64,7 +65,8 @@ VARIANT = (
     "VarInt and ZigZag where the form is theirs), the markdown reference, C (the number in a uint64_t: a form "
     "whose number passes 64 bits, an i64 with `sign: low_bit` over its whole range, is refused in one line) and "
     "the Wireshark dissector. A varint is a plain number: no `scale`, `offset`, `enum`, `flags`, `bits`, `const`, "
-    "`value` or `endian`, not a count or size, not in a group's items (each refused in one line).",
+    "`value` or `endian`, not a count, size or term of a `value:` (each refused in one line); in a group's items "
+    "too, the items then of varying size.",
 )
 #: Field keys a varint refuses (it is a plain number of varying size).
 REFUSED_KEYS = ("const", "bits", "flags", "enum", "value", "endian", "status", "scale", "offset")

@@ -1077,6 +1077,13 @@ def uses_k(fields: tuple[Field, ...]) -> bool:
     )
 
 
+def signed_varints(fields: tuple[Field, ...]) -> bool:
+    """A signed varint at any depth: the decoder's `vs`, its value."""
+    return any(
+        (isinstance(f, Varint) and f.type.signed) or (isinstance(f, Group) and signed_varints(f.fields)) for f in fields
+    )
+
+
 def decoder(ctx: Ctx, message: Message) -> str:
     mid = msg_id(message)
     ctx.counters.clear()
@@ -1088,7 +1095,7 @@ def decoder(ctx: Ctx, message: Message) -> str:
         locals_.append("    size_t len;")
     if uses(message.fields, (Varint,)):  # a varint's number, and its value when signed (encodings/varint.py)
         locals_.append("    uint64_t vn;")
-    if any(isinstance(f, Varint) and f.type.signed for f in message.fields):
+    if signed_varints(message.fields):
         locals_.append("    int64_t vs;")
     if uses_k(message.fields):
         locals_.append("    size_t k;")

@@ -241,7 +241,7 @@ class FieldResolver(Pass):
         if "varint" in spec and spec.get("encoding") != varint.NAME:
             self.error((*path, "varint"), "`varint` goes with `encoding: varint`")
         if spec.get("encoding") == varint.NAME and kind in SCALARS:
-            return self.varint(common, spec, path, parent is not None)
+            return self.varint(common, spec, path)
         if kind in SCALARS or bit_run.width(kind):
             return self.scalar(common, spec, path, endian)
         encoding = spec.get("encoding", "plain")
@@ -573,15 +573,13 @@ class FieldResolver(Pass):
             seven_bit=seven_bits,
         )
 
-    def varint(self, common: dict[str, Any], spec: dict[str, Any], path: Path, in_group: bool) -> Field:
+    def varint(self, common: dict[str, Any], spec: dict[str, Any], path: Path) -> Field:
         """An integer in as many bytes as its value needs (encodings/varint.py)."""
         scalar = SCALARS[spec["type"]]
         options = spec.get("varint") or {}
         sign = str(options.get("sign", ""))
         if why := varint.problem(scalar.name, scalar.signed, scalar.is_float, sign):
             raise self.fail((*path, "varint") if sign else (*path, "encoding"), why)
-        if in_group:
-            raise self.fail((*path, "encoding"), "a varint in a group's items is not supported (items of one size)")
         if odd := [key for key in varint.REFUSED_KEYS if key in spec]:
             raise self.fail((*path, odd[0]), f"`{odd[0]}` does not go with encoding varint (a plain number)")
         low, high = self.bounds(scalar, False, spec.get("range"), (*path, "range"))

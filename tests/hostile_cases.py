@@ -1211,7 +1211,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "a comma in flow-style text",  # the rest of the text after the comma reads as a key
         "tiny",
         replace_text('unit: "0.1°"', "unit: tenths, of a degree"),
-        "commands.move.request.fields.angle.of a degree: unknown key 'of a degree' (expected one of type, use, label, description, description_cn, unit, scale, offset, range, const, default, enum, flags, bits, encoding, endian, size, count, of, bit_order, pad, count_from, value, fields, table, key, start, size_from, select, expect_size, inferred, precision, width, base, case, letters, max_count, status; a comma inside `{...}` ends a value: quote text that holds one)",
+        "commands.move.request.fields.angle.of a degree: unknown key 'of a degree' (expected one of type, use, label, description, description_cn, unit, scale, offset, range, const, default, enum, flags, bits, encoding, varint, endian, size, count, of, bit_order, pad, count_from, value, fields, table, key, start, size_from, select, expect_size, inferred, precision, width, base, case, letters, max_count, status; a comma inside `{...}` ends a value: quote text that holds one)",
     ),
     (
         "example records a computed count as the frame holds it",  # documents print counts and constants

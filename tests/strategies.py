@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 
 MAX_ITEMS = 4  # items per group: enough to cover counts, small enough to fit a length byte
@@ -91,6 +92,8 @@ def _fields_values(
             if f.hidden:
                 continue
             values[f.name] = draw(scalar_value(f))
+        elif isinstance(f, Varint):  # the range's ends too: the most bytes, the sign's largest magnitude
+            values[f.name] = draw(st.one_of(st.sampled_from((f.minimum, f.maximum)), st.integers(f.minimum, f.maximum)))
         elif isinstance(f, Array):
             values[f.name] = draw(st.lists(number(f.item, f.minimum, f.maximum), min_size=f.count, max_size=f.count))
         elif isinstance(f, Packed):

@@ -34,7 +34,7 @@ from hypothesis import strategies as st
 from serialspec import cli
 from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
-from serialspec.encodings import bit_run
+from serialspec.encodings import bit_run, varint
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
 from serialspec.lang.model import (
@@ -250,6 +250,33 @@ CASES: dict[str, Case] = {
             "g": {"type": "group", "count": 2, "fields": {"n": {"type": "string", "size": 2, "encoding": "seven_bit"}}},
             "text": {"type": "string", "size": "rest", "encoding": "seven_bit"},
         }
+    ),
+    # integers in as many bytes as they need: LEB128 (protobuf), zigzag, Kangaroo's 6 bits a byte with the sign in bit
+    # 0, MIDI's highest group first; a fixed field after them and bytes to the end; the reply's in a group's items
+    "encoding: varint": Case(
+        {
+            "a": {"type": "u32", "encoding": "varint"},
+            "z": {"type": "i64", "encoding": "varint", "varint": {"sign": "zigzag"}},
+            "k": {
+                "type": "i32",
+                "encoding": "varint",
+                "varint": {"bits": 6, "sign": "low_bit"},
+                "range": [-100000, 100000],
+                "default": 5,
+                "unit": "mm",
+            },
+            "m": {"type": "u32", "encoding": "varint", "varint": {"order": "high_first"}, "range": [0, 0x0FFFFFFF]},
+            "w": "u16",
+            "tail": {"type": "bytes", "size": "rest"},
+        },
+        {  # a signed varint only in a group's items
+            "w": "u8",
+            "g": {
+                "type": "group",
+                "count": "rest",
+                "fields": {"x": {"type": "i16", "encoding": "varint", "varint": {"sign": "zigzag"}}, "y": "u8"},
+            },
+        },
     ),
     "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
     # bit fields (uN/iN of any width) packed MSB first into runs of whole bytes, every integer key on them, a
@@ -1406,6 +1433,16 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
     assert {"u8", "u16", "u24", "u4"} - used["element type"] == set()
     assert any(bit_run.width(t) for t in used["type"])  # a bit field (uN/iN of another width)
+    forms = [  # every varint form: each sign, each order, another width than 7 bits
+        spec["varint"]
+        for case in CASES.values()
+        for fields in (case.request, case.response)
+        for spec in fields.values()
+        if isinstance(spec, dict) and "varint" in spec
+    ]
+    assert set(varint.SIGNS) <= {form.get("sign") for form in forms}
+    assert set(varint.ORDERS) <= {form.get("order", "low_first") for form in forms}
+    assert any(form.get("bits", 7) != 7 for form in forms)
     assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
 
 

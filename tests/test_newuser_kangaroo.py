@@ -3,12 +3,13 @@ No PyPI peer (PyPI's `kangaroo*` packages are unrelated); the peer is Dimension 
 (KangarooCRC, KangarooCommandWriter), whose rules this test implements to make the golden frames: its CRC's residue
 over a whole packet is the library's KANGAROO_CRC_GOOD_VALUE (0x307E), so the frames are right.
 
-Two gaps closed here, one left:
+Three gaps, closed:
 1. The CRC runs over the LOW 7 BITS of each byte (`crc ^= byte & 0x7F`, then 7 shifts, reflected, polynomial 0x22F0
    reflected = 0x03D1, init and xorout 0x3FFF): `crc: {..., data_bits: 7}` now.
 2. The 14-bit CRC is sent as two 7-bit bytes, low first: `encoding: seven_bit` on the checksum element now.
 3. Numbers are bit-packed (the value shifted left with the sign in bit 0, then 6 bits a byte, bit 6 marking more):
-   the language has no variable-length integer, so the spec carries them as bytes (a strict xfail below)."""
+   `encoding: varint, varint: {bits: 6, sign: low_bit}` reads them as numbers (test_bit_packed_numbers_as_numbers);
+   the spec itself keeps a move's data as bytes, since a limit type and value may follow the number."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from types import ModuleType
 
 import pytest
 from serialspec.lang import load_protocol
-from serialspec.lang.errors import SpecErrors
+from serialspec.runtime.errors import DecodeError
 
 SPEC = Path(__file__).parent / "specs" / "kangaroo.yaml"
 
@@ -122,20 +123,37 @@ def test_the_stream_parser_finds_packets_among_noise(kangaroo: ModuleType) -> No
     assert [kangaroo.encode(m) for m in got] == frames
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=SpecErrors,
-    reason="language gap: bit-packed variable-length numbers (Kangaroo: the value shifted left with the sign in "
-    "bit 0, then 6 bits a byte, lowest first, bit 6 marking more); no `encoding` of a field gives them",
-)
+BIT_PACKED = "{type: i32, encoding: varint, varint: {bits: 6, sign: low_bit},"
+
+
 def test_bit_packed_numbers_as_numbers(tmp_path: Path) -> None:
-    text = SPEC.read_text("utf-8").replace(
-        "values: {type: bytes, size: rest,", "values: {type: i32, encoding: bit_packed,"
-    )
-    assert "bit_packed" in text
+    """Gap 3, closed: `encoding: varint` with 6 bits a byte and the sign in bit 0 reads the library's bit-packed
+    numbers as numbers and writes them byte for byte (the spec keeps bytes: a move's data may go on with a limit)."""
+    from serialspec.backends import emitters
+    from serialspec.backends.python.memory import imported
+
+    text = SPEC.read_text("utf-8").replace("values: {type: bytes, size: rest,", "values: " + BIT_PACKED)
+    text = text.replace("value: {type: bytes, size: rest,", "value: " + BIT_PACKED).replace('"50 1f"', "1000")
     path = tmp_path / "kangaroo.yaml"
     path.write_text(text, "utf-8")
-    load_protocol(path)
+    protocol = load_protocol(path)
+    python = next(e for e in emitters() if e.name == "python")
+    files = {path.split("/", 1)[1]: code for path, code in python.files(protocol).items() if path.count("/") == 1}
+    with imported("kangaroo", files, "the Kangaroo varint test") as k:
+        for number in (0, 1, -1, 31, 32, -32, 1000, -300, 4095, 2**31 - 1, -(2**31)):
+            frame = packet(129, 0x24, b"2\x00\x01" + bit_packed(number))
+            message = k.decode(frame, k.Direction.REQUEST)
+            assert message == k.MoveRequest(address=129, channel=ord("2"), flags=0, motion=1, values=number)
+            assert k.encode(message) == frame
+        reply = k.decode(packet(128, 0x43, b"1\x00\x01" + bit_packed(-1)), k.Direction.RESPONSE)
+        assert reply.value == -1
+        too_long = packet(128, 0x43, b"1\x00\x01" + b"\x40" * 6)  # a 7th byte to come: more than an i32 takes
+        with pytest.raises(DecodeError, match="more than 6 bytes"):
+            k.decode(too_long, k.Direction.RESPONSE)
+        with pytest.raises(DecodeError, match="expected 4..9"):  # longer contents are refused by their size
+            k.decode(packet(128, 0x43, b"1\x00\x01" + b"\x40" * 6 + b"\x00"), k.Direction.RESPONSE)
+        with pytest.raises(DecodeError, match="bits above bit 6"):
+            k.decode(packet(128, 0x43, b"1\x00\x01\x80"), k.Direction.RESPONSE)
 
 
 @pytest.mark.parametrize(

@@ -37,6 +37,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 from strategies import message_fields
 
@@ -121,6 +122,8 @@ def value(field: Field, shown: ET.Element, abbr: str) -> Any:
             if field.bits:
                 return {b.name: int(child(shown, f"{abbr}.{b.name}").get("show") or 0) for b in field.bits}
             return number(shown.get("show") or "")
+        case Varint():
+            return int(shown.get("show") or "")
         case Array() | List() | Packed():
             items = children(shown, f"{abbr}.value")
             if isinstance(field, List) and field.item is None:

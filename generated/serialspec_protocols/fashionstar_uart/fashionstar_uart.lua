@@ -2236,6 +2236,10 @@ local function declare_field(f, abbr)
     f.item = new(item, function()
       return (f.signed and ProtoField.int64 or ProtoField.uint64)(item, f.name, base.DEC, nil, nil, f.description)
     end)
+  elseif kind == "varint" then
+    f.pf = new(abbr, function()
+      return (f.signed and ProtoField.int64 or ProtoField.uint64)(abbr, f.name, base.DEC, nil, nil, f.description)
+    end)
   elseif kind == "text" then
     f.pf = new(abbr, function() return ProtoField.string(abbr, f.name, base.UNICODE, f.description) end)
   elseif kind == "bytes" then
@@ -2689,6 +2693,29 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
       end
     end
     return pos + size
+  elseif kind == "varint" then -- as many bytes as the value needs (encodings/varint.py)
+    local more, number, i = 2 ^ f.bits, 0, 0
+    while true do
+      if i >= f.most then error(string.format("%s: a varint of more than %d bytes", f.name, f.most), 0) end
+      local byte = need(tvb, pos + i, 1, stop, f.name):uint()
+      if byte >= 2 * more then error(string.format("%s: byte %d has bits above bit %d set", f.name, i, f.bits), 0) end
+      local group = byte % more
+      if f.high_first then number = number * more + group else number = number + group * more ^ i end
+      i = i + 1
+      if byte < more then break end
+    end
+    local value = number
+    if f.sign == "zigzag" then
+      value = number % 2 == 1 and -(number + 1) / 2 or number / 2
+    elseif f.sign == "low_bit" then
+      value = number % 2 == 1 and -(number - 1) / 2 or number / 2
+    end
+    if value < f.minimum or value > f.maximum then
+      error(string.format("%s is %.0f, outside %.0f..%.0f", f.name, value, f.minimum, f.maximum), 0)
+    end
+    tree:add(f.pf, tvb(pos, i), f.signed and Int64(value) or UInt64(value))
+    scope[f.name] = value
+    return pos + i
   elseif kind == "text" then
     local size, shown
     if f.size == nil then -- NUL-terminated: the NUL is not part of the text

@@ -14,6 +14,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Checksum,
     Const,
     CString,
+    ExprValidator,
     Float32b,
     Float32l,
     Float64b,
@@ -42,12 +43,15 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Rebuild,
     Struct,
     Switch,
+    VarInt,
+    ZigZag,
     len_,
     this,
 )
 from serialspec.checksums.sum import sum_function
 from serialspec.encodings.bit_run import BitRunMember  # noqa: F401
 from serialspec.encodings.seven_bit import SevenBit, SevenBitText  # noqa: F401
+from serialspec.encodings.varint import VarintOf  # noqa: F401
 from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,

@@ -15,6 +15,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Checksum,
     Const,
     CString,
+    ExprValidator,
     Float32b,
     Float32l,
     Float64b,
@@ -43,6 +44,8 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Rebuild,
     Struct,
     Switch,
+    VarInt,
+    ZigZag,
     len_,
     this,
 )
@@ -50,6 +53,7 @@ from serialspec.checksums.crc import crc_function
 from serialspec.checksums.seed import seeded_function
 from serialspec.encodings.bit_run import BitRunMember  # noqa: F401
 from serialspec.encodings.seven_bit import SevenBit, SevenBitText  # noqa: F401
+from serialspec.encodings.varint import VarintOf  # noqa: F401
 from serialspec.runtime.constructs import (  # noqa: F401
     Framed,
     PackedBits,

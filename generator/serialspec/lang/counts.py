@@ -22,7 +22,7 @@ from collections.abc import Iterable, Sequence
 from typing import Any, assert_never
 
 from serialspec.lang import expression
-from serialspec.lang.model.fields import Bytes, Counted, Field, Group, List, Scalar, Text
+from serialspec.lang.model.fields import Bytes, Counted, Field, Group, List, Scalar, Text, Varint
 from serialspec.lang.model.sizes import counted_term, sized_by_itself
 
 
@@ -57,6 +57,8 @@ def resolve(expr: expression.Expr, earlier: Sequence[Field], later: Iterable[str
             raise CountError(f"{where} {node.name!r} in {shown!r}: a count or size names earlier integer fields")
         if isinstance(field, Text):
             raise CountError(f"{node.name!r} in {shown!r} is text: a count or size names earlier integer fields")
+        if isinstance(field, Varint):
+            raise CountError(f"{node.name!r} in {shown!r} is a varint: a count or size names fixed-size integer fields")
         if not isinstance(field, Scalar) or field.type.is_float:
             raise CountError(f"{node.name!r} in {shown!r} is not an integer field")
         plain = not (field.bits or field.scale is not None or field.offset is not None or field.flags)

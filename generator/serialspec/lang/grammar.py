@@ -16,7 +16,7 @@ from typing import Any, assert_never
 from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
 from serialspec.checksums.crc import KANGAROO_CRC14
-from serialspec.encodings import bit_run, seven_bit
+from serialspec.encodings import bit_run, seven_bit, varint
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
@@ -456,10 +456,22 @@ _FIELD_LONG: dict[str, Shape] = {
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str(
         "How the integer is stored: plain two's complement, sign_magnitude (top bit the sign, the rest the size), or "
-        f"{seven_bit.DOC}; {seven_bit.TEXT_DOC}.",
-        choices=("plain", "sign_magnitude", seven_bit.NAME),
+        f"{seven_bit.DOC}; {seven_bit.TEXT_DOC}; or {varint.DOC}.",
+        choices=("plain", "sign_magnitude", seven_bit.NAME, varint.NAME),
         default="plain",
         example="sign_magnitude",
+    ),
+    "varint": Obj(
+        {
+            "bits": Int(
+                "Value bits a byte; the bit above them marks more bytes.", default=7, minimum=1, maximum=7, example=6
+            ),
+            "order": Str("Which group comes first.", choices=varint.ORDERS, default="low_first", example="high_first"),
+            "sign": Str(
+                "How a signed value is sent (a signed type needs one).", choices=varint.SIGNS, example="zigzag"
+            ),
+        },
+        description=varint.KEY_DOC,
     ),
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf(
@@ -611,6 +623,7 @@ FIELD = OneOf(
                     "line. The C computes it in int64_t (docs/c.md); the Wireshark dissector refuses a count with bit "
                     "operators (`& | << >> ~`: Lua 5.2 has none) in one line.",
                 ),
+                varint.VARIANT,
             ),
         ),
     ),

@@ -5,8 +5,8 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.encodings import seven_bit
-from serialspec.runtime.errors import DecodeError, EncodeError, shown
+from serialspec.encodings import seven_bit, varint
+from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range, shown
 from serialspec.runtime.message import is_sequence
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -121,3 +121,27 @@ def pad_text(value: str, size: int, pad: int, name: str, where: str) -> bytes:
     if len(data) > size:
         raise EncodeError(f"{where}: {name} takes at most {size} bytes of UTF-8, got {len(data)}")
     return data + bytes((pad,)) * (size - len(data))
+
+
+def read_varint(
+    buf: bytes, at: int, end: int, form: tuple[int, bool, str, int], low: int, high: int, name: str, where: str
+) -> tuple[int, int]:
+    """(the value, the offset after it) of a varint field (`encoding: varint`); `form` is (bits a byte, highest
+    group first, sign, most bytes)."""
+    bits, high_first, sign, most = form
+    try:
+        number, stop = varint.read(buf, at, end, bits, high_first, most)
+    except ValueError as exc:
+        raise DecodeError(f"{where}: {name} is no varint: {exc}") from None
+    value = varint.value_of(number, sign)
+    if not low <= value <= high:
+        raise DecodeError(f"{where}: {name} is {value}, outside its range {low}..{high}")
+    return value, stop
+
+
+def write_varint(value: int, form: tuple[int, bool, str, int], low: int, high: int, name: str, where: str) -> bytes:
+    """The bytes of a varint field's value, refused outside its range or when no integer."""
+    if value.__class__ is not int or not low <= value <= high:
+        raise out_of_range(where, name, value, low, high)
+    bits, high_first, sign, _ = form
+    return varint.write(varint.wire(value, sign), bits, high_first)

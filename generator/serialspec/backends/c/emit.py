@@ -20,10 +20,11 @@ from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
-from serialspec.encodings import bit_run, seven_bit
+from serialspec.encodings import bit_run, seven_bit, varint
 from serialspec.lang import counts, expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
+    SCALARS,
     Array,
     BitField,
     Bytes,
@@ -42,6 +43,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
     fixed_bits,
 )
 from serialspec.transforms.replace import Replace
@@ -326,6 +328,9 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
                     raise Unsupported(
                         f"{where}: {f.name}: {'sign-magnitude' if f.sign_magnitude else 'seven_bit'} {f.type.name}"
                     )
+            case Varint():
+                if why := varint.c_problem(f.minimum, f.maximum, f.sign):
+                    raise Unsupported(f"{where}: {f.name}: {why}")
             case Array() | Packed():
                 pass
             case List():
@@ -515,6 +520,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
             case Packed():
                 t = ctype(packed.item_type(f))
                 found.append(Member(name, f"{t} {name}[{f.count}];", doc, t, f.count))
+            case Varint():
+                found.append(Member(name, f"{ctype(f.type)} {name};", doc, ctype(f.type)))
             case _:
                 assert_never(f)
     return found
@@ -815,6 +822,20 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 out.append(f"{pad}o += len;")
             case Packed():
                 out.extend(packed.decode(ctx.p, ctx.P, f, tgt, pad, ctx.counter(depth), ctx.helpers))
+            case Varint():  # as many bytes as its value needs (encodings/varint.py)
+                form = f"{f.bits}u, {int(f.high_first)}u, {f.most_bytes}u"
+                out.append(f"{pad}len = {ctx.p}__varint_get(c + o, n - o, {form}, &vn);")
+                out.append(f"{pad}if (len == 0u) {{ return {ctx.P}_E_CONTENT; }}")
+                ctx.helpers.add("varint_get")
+                held = SCALARS["i64" if f.type.signed else "u64"]
+                value = varint.c_value("vn", f.sign)
+                if f.type.signed:
+                    out.append(f"{pad}vs = {value};")
+                test = range_test(f.minimum, f.maximum, held, "vs" if f.type.signed else "vn")
+                if test:
+                    out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_CONTENT; }}")
+                out.append(f"{pad}{tgt} = ({ctype(f.type)}){'vs' if f.type.signed else 'vn'};")
+                out.append(f"{pad}o += len;")
             case _:
                 assert_never(f)
 
@@ -1058,6 +1079,13 @@ def uses_k(fields: tuple[Field, ...]) -> bool:
     )
 
 
+def signed_varints(fields: tuple[Field, ...]) -> bool:
+    """A signed varint at any depth: the decoder's `vs`, its value."""
+    return any(
+        (isinstance(f, Varint) and f.type.signed) or (isinstance(f, Group) and signed_varints(f.fields)) for f in fields
+    )
+
+
 def decoder(ctx: Ctx, message: Message) -> str:
     mid = msg_id(message)
     ctx.counters.clear()
@@ -1065,8 +1093,12 @@ def decoder(ctx: Ctx, message: Message) -> str:
     body: list[str] = []
     decode_fields(ctx, message.fields, scope, body, 1)
     locals_ = ["    size_t o = 0u;"]
-    if uses(message.fields, (Bytes, Text, List)):
+    if uses(message.fields, (Bytes, Text, List, Varint)):
         locals_.append("    size_t len;")
+    if uses(message.fields, (Varint,)):  # a varint's number, and its value when signed (encodings/varint.py)
+        locals_.append("    uint64_t vn;")
+    if signed_varints(message.fields):
+        locals_.append("    int64_t vs;")
     if uses_k(message.fields):
         locals_.append("    size_t k;")
     locals_ += ctx.counter_locals()
@@ -1235,6 +1267,10 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                     out.append(ctx.loop(pad, depth, f"{f.count}u"))
                     out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                     out.append(f"{pad}}}")
+            case Varint():
+                test = range_test(f.minimum, f.maximum, f.type, tgt)
+                if test:
+                    out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
             case _:
                 assert_never(f)
 
@@ -1404,6 +1440,13 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}}}")
             case Packed():
                 out.extend(packed.encode(ctx.p, ctx.P, f, tgt, pad, ctx.counter(depth), ctx.helpers))
+            case Varint():  # as many bytes as its value needs (encodings/varint.py)
+                wire, form = varint.c_wire(tgt, f.sign), f"{f.bits}u, {int(f.high_first)}u"
+                out.append(
+                    f"{pad}if (cap - o < {ctx.p}__varint_put(NULL, {wire}, {form})) {{ return {ctx.P}_E_BUFFER; }}"
+                )
+                out.append(f"{pad}o += {ctx.p}__varint_put(c + o, {wire}, {form}); /* {f.name} */")
+                ctx.helpers.add("varint_put")
             case _:
                 assert_never(f)
 
@@ -1566,6 +1609,8 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f"{pad}    " + json_number(ctx, packed.item_type(f), f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case Varint():
+                out.append(pad + json_number(ctx, f.type, tgt))
             case _:
                 assert_never(f)
     return first

@@ -30,7 +30,7 @@ from serialspec.backends.c.transforms import dispatch
 from serialspec.backends.c.transforms import method as transform_method
 from serialspec.backends.c.transforms import prefixes as transform_prefixes
 from serialspec.backends.common.frames import layout_codes, layout_index, length_limits
-from serialspec.encodings import seven_bit
+from serialspec.encodings import seven_bit, varint
 from serialspec.lang.model import (
     VALUE_ROLES,
     Direction,
@@ -2486,6 +2486,12 @@ static uint{bits}_t {p}__f{bits}bits({real} f)
         parts.append(
             f"#if {P}_ENABLE_ENCODE\n/* UTF-8 text as 14-bit characters (encoding seven_bit). */\n{code}\n#endif\n"
         )
+    if "varint_get" in ctx.helpers:
+        code = varint.C_GET.replace("P__", f"{p}__")
+        parts.append(f"#if {P}_ENABLE_DECODE\n/* A varint's number (encoding varint). */\n{code}\n#endif\n")
+    if "varint_put" in ctx.helpers:
+        code = varint.C_PUT.replace("P__", f"{p}__")
+        parts.append(f"#if {P}_ENABLE_ENCODE\n/* A varint's bytes (encoding varint). */\n{code}\n#endif\n")
     if "utf8" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_ENCODE || {P}_ENABLE_DECODE

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from typing import Any, Generic, TypeVar, get_args
 
-from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
+from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text, Varint
 from serialspec.lang.model import Field as SpecField
 
-F = TypeVar("F", Scalar, Array, Packed, List, Text, Bytes, Group, TableValue, TableBlock)
+F = TypeVar("F", Scalar, Varint, Array, Packed, List, Text, Bytes, Group, TableValue, TableBlock)
 K = TypeVar("K")
 
 

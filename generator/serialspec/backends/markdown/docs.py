@@ -46,6 +46,7 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    Varint,
     discriminator,
     fixed_size,
     sized_apart,
@@ -172,7 +173,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
                     )
                     for e in f.entries
                 ]
-            case Scalar() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
+            case Scalar() | Varint() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
                 pass  # one row
             case _:
                 assert_never(f)

@@ -9,7 +9,7 @@ from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
-from serialspec.encodings import seven_bit
+from serialspec.encodings import seven_bit, varint
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Array,
@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 
 
@@ -57,6 +58,22 @@ class Kind(Generic[F]):
     def meaning(self, f: F) -> list[str]:
         """What the meaning column says beyond the field's description."""
         return []
+
+
+class VarintKind(Kind[Varint]):
+    model = Varint
+
+    def type_name(self, f: Varint) -> str:
+        return f.type.name + varint.type_note(f.bits, f.sign, f.high_first, f.most_bytes)
+
+    def unit(self, f: Varint) -> str:
+        return f.unit
+
+    def range_text(self, f: Varint) -> str:
+        return scalar_range(f.type, f.minimum, f.maximum)
+
+    def meaning(self, f: Varint) -> list[str]:
+        return [f"default {f.default}"] if f.default is not None else []
 
 
 class ScalarKind(Kind[Scalar]):

@@ -45,6 +45,7 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    Varint,
     refusals_of,
     replies_by_request,
     reply_condition,
@@ -85,7 +86,7 @@ def type_names(f: Field) -> list[str]:
             return [n for n in names if n]
         case Group() | TableBlock():
             return [f.class_name]
-        case Array() | Packed() | List() | Text() | Bytes() | TableValue():
+        case Varint() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
             return []
         case _:
             assert_never(f)

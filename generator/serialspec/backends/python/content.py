@@ -76,6 +76,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
     fixed_size,
 )
 from serialspec.lang.model import Field as SpecField
@@ -107,6 +108,11 @@ def fixed_lengths(fields: list[SpecField]) -> dict[str, int]:
     return found
 
 
+def varint_form(f: Varint) -> str:
+    """The runtime's description of a varint field (packing.py read_varint, write_varint)."""
+    return repr((f.bits, f.high_first, f.sign, f.most_bytes))
+
+
 def bound(f: Scalar, value: float) -> str:
     """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
     as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
@@ -127,6 +133,8 @@ def field_default(f: SpecField) -> str:
     every bit field's constant or default where each has one."""
     if isinstance(f, Bytes):
         return repr(f.default) if f.default is not None else ""
+    if isinstance(f, Varint):
+        return str(f.default) if f.default is not None else ""
     if not isinstance(f, Scalar):
         return ""
     if f.bits:
@@ -376,7 +384,18 @@ class PackageCode:
                     ]
                 )
                 self.helper_classes.append(code)
-            case Scalar() | Group() | TableBlock() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
+            case (
+                Scalar()
+                | Varint()
+                | Group()
+                | TableBlock()
+                | Array()
+                | Packed()
+                | List()
+                | Text()
+                | Bytes()
+                | TableValue()
+            ):
                 pass  # no nested values, or their class is made already
             case _:
                 assert_never(f)
@@ -745,6 +764,13 @@ class PackageCode:
                 return self.local(f)
             case Group():
                 return self.decode_group(f, body, where)
+            case Varint():  # as many bytes as its value needs (encodings/varint.py)
+                self.packing.add("read_varint")
+                span = f"{varint_form(f)}, {f.minimum}, {f.maximum}"
+                read = f"_read_varint(buf, o, end, {span}, {spec_key(f.name)}, {where})"
+                body.append(Code(f"{self.local(f)}, stop = {read}", cursor=True))
+                body.append(Advance(to="stop"))
+                return self.local(f)
             case Scalar() | Array() | Packed() | TableBlock():
                 raise AssertionError(f"{f.name}: a field of fixed size is decoded in a run (decode_run)")
             case _:
@@ -1149,7 +1175,7 @@ class PackageCode:
                         error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
                         body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
                         args.append(Simple(expr))
-                case List() | Group() | TableValue():
+                case List() | Group() | TableValue() | Varint():
                     raise AssertionError(f"{f.name}: a field of varying size is encoded alone (encode_variable)")
                 case _:
                     assert_never(f)
@@ -1218,6 +1244,10 @@ class PackageCode:
                 return f"s.pack({expr})"
             case Group():
                 return self.encode_group(f, obj, body, where, expr, count_error)
+            case Varint():
+                self.packing.add("write_varint")
+                form = varint_form(f)
+                return f"_write_varint({expr}, {form}, {f.minimum}, {f.maximum}, {spec_key(f.name)}, {where})"
             case Scalar() | Array() | Packed() | TableBlock():
                 raise AssertionError(f"{f.name}: a field of fixed size is encoded in a run (encode_run_format)")
             case _:

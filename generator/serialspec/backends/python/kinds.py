@@ -15,6 +15,7 @@ from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import Calls
 from serialspec.backends.python.render import one_line
+from serialspec.encodings import varint
 from serialspec.lang import counts, expression
 from serialspec.lang.model import (
     Array,
@@ -28,6 +29,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 from serialspec.lang.model import Field as SpecField
 from serialspec.lang.names import spec_key
@@ -236,6 +238,23 @@ class ScalarKind(Kind[Scalar]):
         if f.bits:
             return zero_bits(f.bits)
         return number(f.default) if f.default is not None else "0"
+
+
+class VarintKind(Kind[Varint]):
+    model = Varint
+
+    def construct(self, f: Varint, parent: str) -> str:
+        return varint.construct(f.bits, f.sign, f.high_first, f.minimum, f.maximum)
+
+    def annotation(self, f: Varint) -> str:
+        return "int"
+
+    def from_json(self, f: Varint) -> Calls:
+        get = _get(f) if f.default is None else Calls(f"data.get({spec_key(f.name)}, {f.default})", [])
+        return Calls(f"_integer({get}, {spec_key(f.name)}, where)", ["_integer"], get)
+
+    def blank(self, f: Varint) -> str:
+        return str(f.default if f.default is not None else max(f.minimum, min(0, f.maximum)))
 
 
 class ArrayKind(Kind[Array]):

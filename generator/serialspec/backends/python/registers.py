@@ -18,6 +18,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 
 
@@ -33,7 +34,7 @@ def register_tables(protocol: Protocol) -> list[Table]:
                     used.add(f.table.name)
                 case Group():
                     stack.extend(f.fields)
-                case Scalar() | Array() | Packed() | List() | Text() | Bytes() | TableValue() | TableBlock():
+                case Scalar() | Varint() | Array() | Packed() | List() | Text() | Bytes() | TableValue() | TableBlock():
                     pass  # no run of registers
                 case _:
                     assert_never(f)

@@ -28,6 +28,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
     refusals_of,
     replies_by_request,
     reply_condition,
@@ -94,7 +95,7 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
                 stack.extend(reversed(f.fields))
                 if any(isinstance(i, TableValue) for i in f.fields):  # a read fills its items, each by its key
                     found[f.name] = ("group", *(i.name for i in f.fields))
-            case Scalar() | Array() | Packed() | List() | Text() | Bytes():
+            case Scalar() | Varint() | Array() | Packed() | List() | Text() | Bytes():
                 pass  # no table entries
             case _:
                 assert_never(f)

@@ -41,6 +41,7 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    Varint,
     content_bounds,
     discriminator,
     engineering_unit,
@@ -371,6 +372,10 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
                 common["seven_bit"] = True
             if (place := item.bit_place) is not None:  # a member of a bit run (encodings/bit_run.py)
                 common.update(bit_run.lua_field(place.bits, place.shift, place.size, item.type.signed))
+        case Varint():  # as many bytes as the value needs (encodings/varint.py)
+            common.update(kind="varint", bits=item.bits, sign=item.sign or None, high_first=item.high_first or None)
+            common.update(most=item.most_bytes, signed=item.type.signed, minimum=item.minimum, maximum=item.maximum)
+            common["unit"] = item.unit
         case Array():
             common.update(kind="list", type=item.item.name, big=item.endian == ">", count=item.count, unit=item.unit)
         case List():

@@ -173,6 +173,9 @@ from serialspec.lang.model.fields import (
     Text as Text,
 )
 from serialspec.lang.model.fields import (
+    Varint as Varint,
+)
+from serialspec.lang.model.fields import (
     engineering_unit as engineering_unit,
 )
 from serialspec.lang.model.fields import (

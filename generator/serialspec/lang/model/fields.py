@@ -198,6 +198,23 @@ class Scalar(Common):
 
 
 @frozen
+class Varint(Common):
+    """An integer in as many bytes as its value needs (`encoding: varint`, serialspec/encodings/varint.py): `bits`
+    value bits a byte, the bit above them set on every byte but the last; `type` gives the range and what C stores
+    it in, `sign` how a signed value is sent ("": unsigned, zigzag, low_bit)."""
+
+    type: ScalarType
+    bits: int
+    sign: Literal["", "zigzag", "low_bit"]
+    high_first: bool
+    unit: str
+    minimum: int
+    maximum: int
+    default: int | None
+    most_bytes: int  # the most bytes a value of the range takes (decoding refuses more)
+
+
+@frozen
 class Array(Common):
     item: ScalarType
     endian: Literal["<", ">"]
@@ -305,7 +322,7 @@ class TableBlock(Common):
     struct_name: str = ""  # the construct struct of the block
 
 
-Field = Scalar | Array | Packed | List | Text | Bytes | Group | TableValue | TableBlock
+Field = Scalar | Varint | Array | Packed | List | Text | Bytes | Group | TableValue | TableBlock
 
 
 @frozen

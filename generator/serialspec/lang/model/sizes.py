@@ -16,6 +16,7 @@ from serialspec.lang.model.fields import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
 )
 
 
@@ -69,6 +70,9 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
                 high = None if high is None or item.item_size is None else high + c.high * item.item_size
             else:
                 high = None if high is None else high + c.high
+        elif isinstance(item, Varint):  # one byte at least, as many as its widest value needs at most
+            low += 1
+            high = None if high is None else high + item.most_bytes
         elif isinstance(item, TableValue):
             sizes = [e.type.size for e in item.table.entries if not e.reserved]
             low += min(sizes)

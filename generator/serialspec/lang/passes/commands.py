@@ -26,6 +26,7 @@ from serialspec.lang.model import (
     Subcommand,
     Table,
     TableEntry,
+    Varint,
     content_bounds,
     discriminator,
     fixed_size,
@@ -495,6 +496,12 @@ class Commands(FieldResolver):
                 if why := counts.unsized(fields):
                     if not any(p[: len(where) + 1] == (*where, why[0]) for p in said):  # one mistake, one line
                         self.error((*where, why[0], why[1]), why[2])
+                elif not sized_by_itself(fields) and (vlen := [f for f in fields if isinstance(f, Varint)]):
+                    self.error(
+                        (*where, vlen[0].name, "encoding"),
+                        "a varint cannot size a frame that has no length element, trailer or transform: a stream "
+                        "parser could not tell where it ends (give the frame a length element)",
+                    )
                 elif not sized_by_itself(fields) and (rest := rest_taker(fields)):
                     if any(p[: len(where) + 1] == (*where, rest[0].name) for p in said):
                         continue  # its size said wrong already (a `size_from` it could not read): one line

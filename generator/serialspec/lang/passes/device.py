@@ -39,6 +39,7 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Unsolicited,
+    Varint,
     replies_by_request,
     reply_to,
 )
@@ -546,6 +547,7 @@ class DevicePass(Pass):
             for name, f in self.request_values(request).items()
             if name not in named
             and not (isinstance(f, Scalar) and (f.hidden or f.default is not None))
+            and not (isinstance(f, Varint) and f.default is not None)
             and not (isinstance(f, FrameElement) and f.type is None)
         ]
         if missing:

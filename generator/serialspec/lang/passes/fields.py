@@ -6,7 +6,7 @@ import re
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec.encodings import bit_run, seven_bit
+from serialspec.encodings import bit_run, seven_bit, varint
 from serialspec.lang import counts, expression, grammar
 from serialspec.lang.errors import listed
 from serialspec.lang.loader import Path
@@ -27,6 +27,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    Varint,
     fixed_size,
     sum_sizes,
     takes_rest,
@@ -134,7 +135,9 @@ class FieldResolver(Pass):
                         f"field (`size: {field.name}`), which encode then writes",
                     )
                 integer = isinstance(other, Scalar) and not other.type.is_float
-                if isinstance(node, expression.Name) and other is not None and not integer:
+                if isinstance(node, expression.Name) and isinstance(other, Varint):
+                    self.error(where, f"{node.name} is a varint: a `value:` names fixed-size integer fields")
+                elif isinstance(node, expression.Name) and other is not None and not integer:
                     self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")
                 elif isinstance(node, expression.Name) and isinstance(other, Scalar) and other.bits:
                     # its message value is the bit fields, not a number: encode could not compute the expression
@@ -235,6 +238,10 @@ class FieldResolver(Pass):
             inferred=str(spec.get("inferred", "")),
         )
         endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
+        if "varint" in spec and spec.get("encoding") != varint.NAME:
+            self.error((*path, "varint"), "`varint` goes with `encoding: varint`")
+        if spec.get("encoding") == varint.NAME and kind in SCALARS:
+            return self.varint(common, spec, path)
         if kind in SCALARS or bit_run.width(kind):
             return self.scalar(common, spec, path, endian)
         encoding = spec.get("encoding", "plain")
@@ -564,6 +571,36 @@ class FieldResolver(Pass):
             offset=spec.get("offset"),
             value_at=self.doc.where((*path, "value")),
             seven_bit=seven_bits,
+        )
+
+    def varint(self, common: dict[str, Any], spec: dict[str, Any], path: Path) -> Field:
+        """An integer in as many bytes as its value needs (encodings/varint.py)."""
+        scalar = SCALARS[spec["type"]]
+        options = spec.get("varint") or {}
+        sign = str(options.get("sign", ""))
+        if why := varint.problem(scalar.name, scalar.signed, scalar.is_float, sign):
+            raise self.fail((*path, "varint") if sign else (*path, "encoding"), why)
+        if odd := [key for key in varint.REFUSED_KEYS if key in spec]:
+            raise self.fail((*path, odd[0]), f"`{odd[0]}` does not go with encoding varint (a plain number)")
+        low, high = self.bounds(scalar, False, spec.get("range"), (*path, "range"))
+        default = spec.get("default")
+        if isinstance(default, str) or (default is not None and not float(default).is_integer()):
+            raise self.fail((*path, "default"), f"expected a whole number, got {default!r}")
+        if default is not None and not low <= default <= high:
+            self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
+        bits = int(options.get("bits", 7))
+        sign_: Literal["", "zigzag", "low_bit"] = "zigzag" if sign == "zigzag" else "low_bit" if sign else ""
+        return Varint(
+            **common,
+            type=scalar,
+            bits=bits,
+            sign=sign_,
+            high_first=options.get("order") == "high_first",
+            unit=str(spec.get("unit", "")),
+            minimum=int(low),
+            maximum=int(high),
+            default=None if default is None else int(default),
+            most_bytes=varint.most_bytes(int(low), int(high), bits, sign),
         )
 
     def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:

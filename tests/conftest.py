@@ -15,7 +15,17 @@ import pytest
 from hypothesis import Phase, find, settings
 from hypothesis import strategies as st
 from serialspec.lang import load_protocol
-from serialspec.lang.model import Bytes, Direction, Example, FrameElement, FrameLayout, Message, Protocol
+from serialspec.lang.model import (
+    Bytes,
+    Direction,
+    Example,
+    FrameElement,
+    FrameLayout,
+    Message,
+    Protocol,
+    refusals_of,
+    replies_by_request,
+)
 from strategies import message_fields
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
@@ -103,9 +113,16 @@ def message_class(g: Generated, spec: Message) -> Any:
 
 
 def request_spec(g: Generated, spec: Message) -> Message:
-    """The request of a reply's command (of its sub-command, where it has one)."""
+    """The request of a reply's command (of its sub-command, where it has one); for a refusal of a command with no
+    request (`refused_by`: STM32's NACK, no code), the first request it refuses."""
     command = g.protocol.command(spec.command)
     request = next((s.request for s in command.subcommands if s.name == spec.subcommand), command.request)
+    if request is None:
+        replies = replies_by_request(g.protocol.messages())
+        request = next(
+            (m for m in g.protocol.messages() if m.direction == Direction.REQUEST and spec in refusals_of(m, replies)),
+            None,
+        )
     assert request is not None, f"{spec.class_name} answers no request"
     return request
 

@@ -43,13 +43,19 @@ def test_the_corpus_has_every_kind() -> None:
 
 
 def expect_frames(package: Any, direction: str | None, stream: bytes, expected: list[bytes]) -> None:
-    """The stream parser delivers these frames from the stream fed whole, byte by byte and cut in two anywhere."""
-    splits = [[stream], [bytes([b]) for b in stream]]
+    """The stream parser delivers these frames from the stream fed whole, byte by byte and cut in two anywhere, and
+    counts the same errors and garbage and holds the same bytes whatever the reads (byte by byte's)."""
+    splits = [[bytes([b]) for b in stream], [stream]]
     splits += [[stream[:cut], stream[cut:]] for cut in range(1, len(stream))]
+    counts = None
     for reads in splits:
         parser = package.StreamParser(direction)
         found = [package.encode(message) for chunk in reads for message in parser.feed(chunk)]
         assert found == expected, [len(r) for r in reads]
+        # (a text parser counts corrupt lines alone)
+        counted = tuple(getattr(parser, name, None) for name in ("errors", "garbage", "corrupt")), parser.pending()
+        counts = counts or counted
+        assert counted == counts, [len(r) for r in reads]
 
 
 @pytest.mark.parametrize("path", cases("streams"))

@@ -13,8 +13,8 @@ from typing import Any
 
 import pytest
 import yaml
-from conftest import generate_and_import
-from hypothesis import given, settings
+from conftest import examples, generate_and_import
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.errors import DecodeError
@@ -244,5 +244,80 @@ def test_the_c_sends_a_code_in_the_layout_that_holds_it_as_its_expression(tmp_pa
         assert driver.ask(f"rt request {big.hex()}") == [f"ok {big.hex()}"]  # decoded, then encoded in `long`
         assert driver.ask("rt request 1003") == ["ok 1003"]
         assert driver.ask("dec request f0341207") == ["err E_UNKNOWN"]  # 0x1234 itself is no code sent in `long`
+    finally:
+        driver.close()
+
+
+RPLIDAR = Path(__file__).parent / "specs" / "slamtec_rplidar.yaml"
+# RPLIDAR responses where the headed frame is the one to take: a scan descriptor and an info reply with no measurement
+# inside them (at every place inside, the angle's check bit, bit 0 of the second byte, is clear), measurements
+# after the descriptor, a health reply (a measurement inside it ends first), garbage and a stray header between them
+RPLIDAR_STREAMS = [
+    "a5 5a 06 00 00 40 81 3e 01 02 10 27 3d 81 02 20 4e",
+    "a5 5a 14 00 00 00 04" + " 02" * 20 + " a5 5a 06 00 00 40 81",
+    "a5 5a 03 00 00 00 a5 5a 14 00 00 00 04" + " 00" * 20,
+    "00 a5 5a a5 5a 06 00 00 40 81 a5 5a 03 00 00 00 06 00 00 00 ff a5",
+]
+
+
+def test_the_c_reads_a_headerless_layout_beside_headed_ones_as_python_does(tmp_path: Path) -> None:
+    """RPLIDAR's responses: replies and scan descriptors after their header beside headerless 5-byte measurements
+    (layouts chosen by command). Where several layouts fit at one place, the frame is the first of them to complete
+    that decodes: the C took the first complete one alone, so the measurement failing at every `A5 5A` (its check
+    bit is bit 0 of 0x5A) lost the reply or descriptor there. Fixed and noisy streams of every response, in pieces,
+    give the Python parser's frames and counts; the vector check shipped beside the C (a frame inside a vector that
+    ends first is taken first, as Python's parser takes it) passes under the strict flags."""
+    import subprocess
+
+    from conftest import Generated, message_class
+    from serialspec.backends.c.build import files as c_files
+    from serialspec.backends.python.memory import imported
+    from serialspec.backends.python.package import emit_package
+    from serialspec.lang.loader import load_file
+    from serialspec.lang.model import Direction
+    from serialspec.lang.resolve import resolve
+    from strategies import message_fields
+    from test_c_backend import FLAGS, GCC, Driver, stream_agrees_with_python
+
+    if GCC is None:
+        pytest.skip("no C compiler")
+    protocol = resolve(load_file(str(RPLIDAR), RPLIDAR.name))
+    name = protocol.name
+    for path, text in c_files(protocol).items():
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text(text, encoding="utf-8")
+    source = tmp_path / name
+    sources = [str(source / "test" / "check_vectors.c"), str(source / f"{name}.c")]
+    built = subprocess.run([GCC, *FLAGS, *sources, "-o", str(tmp_path / "check")], capture_output=True, text=True)
+    assert built.returncode == 0 and not built.stderr, built.stderr
+    checked = subprocess.run([str(tmp_path / "check")], capture_output=True, text=True, timeout=60)
+    assert checked.stdout == f"{name}: 5 vectors, 0 refused frames, 0 failed\n", checked.stdout
+    driver = Driver(name, source, tmp_path)
+    try:
+        with imported(name, emit_package(protocol)) as package:
+            g = Generated(protocol, package, package)
+            for stream in RPLIDAR_STREAMS:
+                for sizes in ("1", "3,0,7", "64"):
+                    stream_agrees_with_python(driver, g, Direction.RESPONSE, bytes.fromhex(stream), sizes)
+            responses = [m for m in protocol.messages() if m.direction == Direction.RESPONSE]
+            frames = st.one_of(
+                [
+                    message_fields(protocol, m).map(lambda f, m=m: package.encode(message_class(g, m).from_fields(f)))
+                    for m in responses
+                ]
+            )
+            piece = st.one_of(
+                frames,
+                frames.flatmap(lambda f: st.integers(0, len(f) - 1).map(lambda k: f[:k])),  # cut short
+                st.binary(max_size=4),
+                st.just(b"\xa5\x5a"),
+            )
+
+            @settings(max_examples=examples(10), deadline=None, suppress_health_check=list(HealthCheck))
+            @given(st.lists(piece, max_size=8).map(b"".join), st.lists(st.integers(0, 9), min_size=1, max_size=5))
+            def agree(stream: bytes, sizes: list[int]) -> None:
+                stream_agrees_with_python(driver, g, Direction.RESPONSE, stream, ",".join(map(str, [*sizes, 1])))
+
+            agree()
     finally:
         driver.close()

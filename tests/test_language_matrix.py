@@ -42,6 +42,7 @@ from serialspec.lang.model import (
     Message,
     Protocol,
     leading_constant,
+    refusals_of,
     replies_by_request,
     reply_to,
 )
@@ -1659,13 +1660,15 @@ def requesting(g: Generated) -> bool:
 
 
 def asked(g: Generated, message: Message) -> Any:
-    """A request the response `message` answers, where replies are read with their request; else None."""
+    """A request the response `message` answers (or refuses: `refused_by`), where replies are read with their
+    request; else None."""
     if not requesting(g) or message.direction.value != "response":
         return None
+    replies = replies_by_request(g.protocol.messages())
     request = next(
         m
         for m in g.protocol.messages()
-        if m.direction.value == "request" and reply_to(m, replies_by_request(g.protocol.messages())) == message
+        if m.direction.value == "request" and (reply_to(m, replies) == message or message in refusals_of(m, replies))
     )
     return message_class(g, request).from_fields(st_examples(message_fields(g.protocol, request), 1)[0])
 

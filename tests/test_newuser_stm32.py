@@ -182,3 +182,33 @@ def test_size_from_mistakes_are_one_line_each(tmp_path: Path) -> None:
     assert spec_error(
         registers.replace("size_from: request.length,", "size_from: request.length + 1,"), tmp_path
     ).endswith("a run of registers is as long as the request's field: no `+ N`")
+
+
+def test_the_suites_give_a_nack_a_request_it_refuses(stm: ModuleType) -> None:
+    """NACK is no command's reply (no code, no request of its own) and refuses every command that names it in
+    `refused_by`. The suites' helpers for replies read with their request (conftest's request_spec, a_request and
+    requests; the language matrix's asked) give it one of those requests (they failed: its command has no request,
+    and no request has it as its reply), with which it encodes, decodes, and is taken by a stream parser awaiting
+    that request's reply."""
+    from conftest import Generated, a_request, request_spec, requests
+    from hypothesis import Phase, find
+    from serialspec.lang import load_protocol
+    from test_language_matrix import asked
+
+    protocol = load_protocol(str(SPEC))
+    g = Generated(protocol, stm, stm)
+    nack = next(m for m in protocol.messages() if m.command == "nack")
+    refused = {
+        m.class_name: m for m in protocol.messages() if m.direction.value == "request" and "nack" in m.refused_by
+    }
+    assert len(refused) > 1 and request_spec(g, nack).class_name in refused
+    drawn = find(requests(g, nack), lambda _: True, settings=settings(database=None, phases=[Phase.generate]))
+    for request in (a_request(g, nack), asked(g, nack), drawn):
+        assert type(request).__name__ in refused
+        frame = stm.encode(stm.NackResponse(), request)
+        assert frame == b"\x1f"
+        assert stm.decode(frame, "response", request=request) == stm.NackResponse()
+        reply = next(m for m in protocol.messages() if m.direction.value == "response" and m.command == request.COMMAND)
+        parser = stm.StreamParser("response")
+        parser.expect(getattr(stm, reply.class_name), request)
+        assert parser.feed(frame) == [stm.NackResponse()]

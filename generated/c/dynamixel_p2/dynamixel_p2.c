@@ -25,6 +25,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
 #define DYNAMIXEL_P2__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
+#define DYNAMIXEL_P2__MOST_LAYOUTS 1u /* the most layouts of a direction */
 #define DYNAMIXEL_P2__TABLES (DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (DYNAMIXEL_P2_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */
@@ -2017,11 +2018,16 @@ void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direct
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
  * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
- * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). Where several
+ * layouts fit, the one that completes first and decodes is the frame (Python's FrameStreamParser._sizes): the
+ * complete sizes are tried shortest first, and one that fails leaves the next its chance, or the wait for a layout
+ * still incomplete (RPLIDAR: a 5-byte measurement that fails before the 7-byte scan descriptor at one place). */
 static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_msg_t *out, size_t *size)
 {
-    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k;
+    uint8_t count = dynamixel_p2__count(DYNAMIXEL_P2__RX(p->dir)), k, i, j, m = 0u;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    size_t sizes[DYNAMIXEL_P2__MOST_LAYOUTS] = {0u}; /* the complete layouts' sizes, shortest first, each once */
+    size_t unknown = 0u;             /* the first size whose frame has a good checksum and an unknown command */
     int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -2032,7 +2038,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
             need = 0u;
             continue;
         }
-        if (s < 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME) {
+        if (s <= 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME) { /* (a reply its request sizes at 0 bytes: no frame) */
             continue;
         }
         if ((size_t)s > p->n - pos) {
@@ -2041,26 +2047,37 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
             }
             continue;
         }
-        r = dynamixel_p2_decode_expect(p->buf + pos, (size_t)s, DYNAMIXEL_P2__RX(p->dir), p->expect, out);
-        if (r == DYNAMIXEL_P2_E_UNKNOWN) {
-            *size = (size_t)s;
-            return DYNAMIXEL_P2__V_UNKNOWN;
+        for (i = 0u; i < m && sizes[i] < (size_t)s; i++) {
         }
-        if (r != DYNAMIXEL_P2_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = DYNAMIXEL_P2__V_CORRUPT;
-            }
-            return DYNAMIXEL_P2__V_CORRUPT;
+        if (i < m && sizes[i] == (size_t)s) { /* a size already there: the same bytes, the same verdict */
+            continue;
         }
-        *size = (size_t)s;
-        return DYNAMIXEL_P2__ACCEPT;
+        for (j = m; j > i; j--) {
+            sizes[j] = sizes[j - 1u];
+        }
+        sizes[i] = (size_t)s;
+        m++;
+    }
+    for (i = 0u; i < m; i++) {
+        r = dynamixel_p2_decode_expect(p->buf + pos, sizes[i], DYNAMIXEL_P2__RX(p->dir), p->expect, out);
+        if (r == DYNAMIXEL_P2_OK) {
+            *size = sizes[i];
+            return DYNAMIXEL_P2__ACCEPT;
+        }
+        if (r == DYNAMIXEL_P2_E_UNKNOWN && unknown == 0u) {
+            unknown = sizes[i];
+        }
     }
     if (need != (size_t)-1) {
         *size = need;
         return DYNAMIXEL_P2__V_WAIT;
     }
-    p->verdict[pos] = DYNAMIXEL_P2__V_NONE;
-    return DYNAMIXEL_P2__V_NONE;
+    if (unknown != 0u) {
+        *size = unknown;
+        return DYNAMIXEL_P2__V_UNKNOWN;
+    }
+    p->verdict[pos] = m > 0u ? DYNAMIXEL_P2__V_CORRUPT : DYNAMIXEL_P2__V_NONE;
+    return p->verdict[pos];
 }
 
 /* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */

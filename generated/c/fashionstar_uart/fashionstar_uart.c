@@ -25,6 +25,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
 #define FASHIONSTAR_UART__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
+#define FASHIONSTAR_UART__MOST_LAYOUTS 1u /* the most layouts of a direction */
 #define FASHIONSTAR_UART__TABLES (FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FASHIONSTAR_UART_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */

@@ -25,6 +25,7 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
 #define FEETECH_SMS__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define FEETECH_SMS__SINGLE 1 /* one layout per direction */
+#define FEETECH_SMS__MOST_LAYOUTS 1u /* the most layouts of a direction */
 #define FEETECH_SMS__TABLES (FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (FEETECH_SMS_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */

@@ -25,6 +25,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
 #define HIWONDER_RRC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
+#define HIWONDER_RRC__MOST_LAYOUTS 1u /* the most layouts of a direction */
 #define HIWONDER_RRC__TABLES (HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (HIWONDER_RRC_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */

@@ -25,6 +25,7 @@ typedef char roboclaw__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define ROBOCLAW__LENGTHS 0 /* every layout has a length element */
 #define ROBOCLAW__SIZED 1 /* some layout's size follows from its content's leading fields (a size rule) */
 #define ROBOCLAW__SINGLE 0 /* one layout per direction */
+#define ROBOCLAW__MOST_LAYOUTS 2u /* the most layouts of a direction */
 #define ROBOCLAW__TABLES (ROBOCLAW_ENABLE_ENCODE || ROBOCLAW__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (ROBOCLAW_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */
@@ -4182,11 +4183,16 @@ void roboclaw_parser_init(roboclaw_parser_t *parser, roboclaw_direction_t dir)
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
  * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
- * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). Where several
+ * layouts fit, the one that completes first and decodes is the frame (Python's FrameStreamParser._sizes): the
+ * complete sizes are tried shortest first, and one that fails leaves the next its chance, or the wait for a layout
+ * still incomplete (RPLIDAR: a 5-byte measurement that fails before the 7-byte scan descriptor at one place). */
 static int roboclaw__try(roboclaw_parser_t *p, size_t pos, roboclaw_msg_t *out, size_t *size)
 {
-    uint8_t count = roboclaw__count(ROBOCLAW__RX(p->dir)), k;
+    uint8_t count = roboclaw__count(ROBOCLAW__RX(p->dir)), k, i, j, m = 0u;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    size_t sizes[ROBOCLAW__MOST_LAYOUTS] = {0u}; /* the complete layouts' sizes, shortest first, each once */
+    size_t unknown = 0u;             /* the first size whose frame has a good checksum and an unknown command */
     int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -4197,7 +4203,7 @@ static int roboclaw__try(roboclaw_parser_t *p, size_t pos, roboclaw_msg_t *out, 
             need = 0u;
             continue;
         }
-        if (s < 0 || (unsigned long)s > ROBOCLAW_MAX_FRAME) {
+        if (s <= 0 || (unsigned long)s > ROBOCLAW_MAX_FRAME) { /* (a reply its request sizes at 0 bytes: no frame) */
             continue;
         }
         if ((size_t)s > p->n - pos) {
@@ -4206,26 +4212,37 @@ static int roboclaw__try(roboclaw_parser_t *p, size_t pos, roboclaw_msg_t *out, 
             }
             continue;
         }
-        r = roboclaw__decode_with(p->buf + pos, (size_t)s, ROBOCLAW__RX(p->dir), p->expect, p->has_request ? p->request : NULL, p->request_len, out);
-        if (r == ROBOCLAW_E_UNKNOWN) {
-            *size = (size_t)s;
-            return ROBOCLAW__V_UNKNOWN;
+        for (i = 0u; i < m && sizes[i] < (size_t)s; i++) {
         }
-        if (r != ROBOCLAW_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = ROBOCLAW__V_CORRUPT;
-            }
-            return ROBOCLAW__V_CORRUPT;
+        if (i < m && sizes[i] == (size_t)s) { /* a size already there: the same bytes, the same verdict */
+            continue;
         }
-        *size = (size_t)s;
-        return ROBOCLAW__ACCEPT;
+        for (j = m; j > i; j--) {
+            sizes[j] = sizes[j - 1u];
+        }
+        sizes[i] = (size_t)s;
+        m++;
+    }
+    for (i = 0u; i < m; i++) {
+        r = roboclaw__decode_with(p->buf + pos, sizes[i], ROBOCLAW__RX(p->dir), p->expect, p->has_request ? p->request : NULL, p->request_len, out);
+        if (r == ROBOCLAW_OK) {
+            *size = sizes[i];
+            return ROBOCLAW__ACCEPT;
+        }
+        if (r == ROBOCLAW_E_UNKNOWN && unknown == 0u) {
+            unknown = sizes[i];
+        }
     }
     if (need != (size_t)-1) {
         *size = need;
         return ROBOCLAW__V_WAIT;
     }
-    p->verdict[pos] = ROBOCLAW__V_NONE;
-    return ROBOCLAW__V_NONE;
+    if (unknown != 0u) {
+        *size = unknown;
+        return ROBOCLAW__V_UNKNOWN;
+    }
+    p->verdict[pos] = m > 0u ? ROBOCLAW__V_CORRUPT : ROBOCLAW__V_NONE;
+    return p->verdict[pos];
 }
 
 /* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */

@@ -25,6 +25,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__LENGTHS 1 /* every layout has a length element */
 #define VESC__SIZED 0 /* some layout's size follows from its content's leading fields (a size rule) */
 #define VESC__SINGLE 0 /* one layout per direction */
+#define VESC__MOST_LAYOUTS 2u /* the most layouts of a direction */
 #define VESC__TABLES (VESC_ENABLE_ENCODE || VESC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes (VESC_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */
@@ -2255,11 +2256,16 @@ void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
  * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
- * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). Where several
+ * layouts fit, the one that completes first and decodes is the frame (Python's FrameStreamParser._sizes): the
+ * complete sizes are tried shortest first, and one that fails leaves the next its chance, or the wait for a layout
+ * still incomplete (RPLIDAR: a 5-byte measurement that fails before the 7-byte scan descriptor at one place). */
 static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size)
 {
-    uint8_t count = vesc__count(VESC__RX(p->dir)), k;
+    uint8_t count = vesc__count(VESC__RX(p->dir)), k, i, j, m = 0u;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    size_t sizes[VESC__MOST_LAYOUTS] = {0u}; /* the complete layouts' sizes, shortest first, each once */
+    size_t unknown = 0u;             /* the first size whose frame has a good checksum and an unknown command */
     int r;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -2270,7 +2276,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
             need = 0u;
             continue;
         }
-        if (s < 0 || (unsigned long)s > VESC_MAX_FRAME) {
+        if (s <= 0 || (unsigned long)s > VESC_MAX_FRAME) { /* (a reply its request sizes at 0 bytes: no frame) */
             continue;
         }
         if ((size_t)s > p->n - pos) {
@@ -2279,26 +2285,37 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
             }
             continue;
         }
-        r = vesc_decode_expect(p->buf + pos, (size_t)s, VESC__RX(p->dir), p->expect, out);
-        if (r == VESC_E_UNKNOWN) {
-            *size = (size_t)s;
-            return VESC__V_UNKNOWN;
+        for (i = 0u; i < m && sizes[i] < (size_t)s; i++) {
         }
-        if (r != VESC_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = VESC__V_CORRUPT;
-            }
-            return VESC__V_CORRUPT;
+        if (i < m && sizes[i] == (size_t)s) { /* a size already there: the same bytes, the same verdict */
+            continue;
         }
-        *size = (size_t)s;
-        return VESC__ACCEPT;
+        for (j = m; j > i; j--) {
+            sizes[j] = sizes[j - 1u];
+        }
+        sizes[i] = (size_t)s;
+        m++;
+    }
+    for (i = 0u; i < m; i++) {
+        r = vesc_decode_expect(p->buf + pos, sizes[i], VESC__RX(p->dir), p->expect, out);
+        if (r == VESC_OK) {
+            *size = sizes[i];
+            return VESC__ACCEPT;
+        }
+        if (r == VESC_E_UNKNOWN && unknown == 0u) {
+            unknown = sizes[i];
+        }
     }
     if (need != (size_t)-1) {
         *size = need;
         return VESC__V_WAIT;
     }
-    p->verdict[pos] = VESC__V_NONE;
-    return VESC__V_NONE;
+    if (unknown != 0u) {
+        *size = unknown;
+        return VESC__V_UNKNOWN;
+    }
+    p->verdict[pos] = m > 0u ? VESC__V_CORRUPT : VESC__V_NONE;
+    return p->verdict[pos];
 }
 
 /* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */

@@ -1181,7 +1181,8 @@ class FrameStreamParser(StreamParser):
         """One pass over the candidates from the last frame taken on: the valid frame that ends first (then starts
         first) among them is the next one taken, and no candidate after it needs a look once none can end before it.
         A corrupt candidate counts as an error when the byte-by-byte scan would have decided it before taking that
-        frame: when it and every candidate before it had all their bytes by the time that frame ended."""
+        frame: when it and every candidate before it had all their bytes by the time that frame ended (a layout that
+        says no frame only from a byte after it left its candidate undecided then: _late)."""
         buffer = self._pending + bytes(data)
         end = len(buffer)
         found: list[Message] = []
@@ -1194,6 +1195,7 @@ class FrameStreamParser(StreamParser):
             bound = end + 1  # where the best frame so far ends: a frame must end before it to win
             seen: list[tuple[int, int, bool]] = []  # candidates before it: (start, end or end + 1, corrupt)
             displaced: list[tuple[int, int, bool]] = []  # frames taken for best, then beaten by one ending first
+            refused: list[int] = []  # candidates no frame or corrupt where a layout said no frame (see _late)
             waiting = False
             position = start
             while True:
@@ -1212,7 +1214,8 @@ class FrameStreamParser(StreamParser):
                 # the candidate's frame; one that fails leaves the next its chance (RPLIDAR: a 5-byte measurement
                 # that fails before the 7-byte scan descriptor at the same place)
                 outcome: tuple[int, bool] | None = None  # where the candidate is decided (end + 1: waiting), corrupt
-                for stop, decode, verify in self._sizes(buffer, position, end):
+                sizes = self._sizes(buffer, position, end)
+                for stop, decode, verify in sizes:
                     if decode is None:  # still waiting for bytes
                         outcome = (end + 1, False)
                         waiting = True
@@ -1240,13 +1243,16 @@ class FrameStreamParser(StreamParser):
                     outcome = (stop, True)
                 if outcome is not None:
                     seen.append((position, *outcome))
+                if (outcome is None or outcome[1]) and len(sizes) < len(self._sizers_by_first[buffer[position]]):
+                    refused.append(position)  # (a layout said no frame: perhaps from bytes after the frame taken)
                 position += 1
             first, last = (best[1], best[2]) if best is not None else (end + 1, end)
             hold = -1
             if displaced:
                 seen = sorted(seen + displaced)
+            late = self._late(buffer, refused, first, last) if refused and best is not None else first
             for position, stop, corrupt in seen:
-                if position >= first:
+                if position >= first or position >= late:
                     break
                 if stop > last:  # undecided when the frame taken ended (or the bytes ran out)
                     hold = position
@@ -1267,6 +1273,18 @@ class FrameStreamParser(StreamParser):
         self.garbage += cut - start
         self._pending = buffer[cut:]
         return found
+
+    def _late(self, buffer: bytes, refused: list[int], first: int, last: int) -> int:
+        """The first of the `refused` candidates before the frame taken (at first..last) still waiting for bytes when
+        it ended, else `first`. A layout that says no frame from a byte after that frame (RPLIDAR: a reply's
+        unknown data type, the byte after a measurement inside its descriptor) left the candidate undecided then, as
+        the byte-by-byte scan finds it: no corrupt candidate after it is counted before that frame."""
+        for position in refused:
+            if position >= first:
+                break
+            if any(decode is None for _, decode, _ in self._sizes(buffer, position, last)):
+                return position
+        return first
 
     def _sizes(self, buffer: bytes, position: int, end: int) -> list[tuple[int, Decode | None, Verify | None]]:
         """The layouts that fit the candidate at `position`, the one that completes first first (of two ending

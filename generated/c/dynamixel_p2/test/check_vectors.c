@@ -49,12 +49,14 @@ int main(void)
 #if DYNAMIXEL_P2_ENABLE_PARSER
         if (decodes) {
             dynamixel_p2_parser_t parser;
-            size_t at = 0;
+            size_t at = 0u, from = 0u, to = v->len, found = 0u;
+            const uint8_t *frame;
             bool got = false;
             dynamixel_p2_parser_init(&parser, v->direction);
             while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */
                 at += dynamixel_p2_parser_feed(&parser, v->frame + at, 1, &msg, &got);
-            if (!got || at != v->len)
+            frame = dynamixel_p2_parser_frame(&parser, &found);
+            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)
                 dynamixel_p2__fail(&failed, v->name, "the parser does not find the frame", DYNAMIXEL_P2_OK);
         }
 #endif

@@ -49,12 +49,14 @@ int main(void)
 #if FASHIONSTAR_UART_ENABLE_PARSER
         if (decodes) {
             fashionstar_uart_parser_t parser;
-            size_t at = 0;
+            size_t at = 0u, from = 0u, to = v->len, found = 0u;
+            const uint8_t *frame;
             bool got = false;
             fashionstar_uart_parser_init(&parser, v->direction);
             while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */
                 at += fashionstar_uart_parser_feed(&parser, v->frame + at, 1, &msg, &got);
-            if (!got || at != v->len)
+            frame = fashionstar_uart_parser_frame(&parser, &found);
+            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)
                 fashionstar_uart__fail(&failed, v->name, "the parser does not find the frame", FASHIONSTAR_UART_OK);
         }
 #endif

@@ -49,12 +49,14 @@ int main(void)
 #if HIWONDER_RRC_ENABLE_PARSER
         if (decodes) {
             hiwonder_rrc_parser_t parser;
-            size_t at = 0;
+            size_t at = 0u, from = 0u, to = v->len, found = 0u;
+            const uint8_t *frame;
             bool got = false;
             hiwonder_rrc_parser_init(&parser, v->direction);
             while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */
                 at += hiwonder_rrc_parser_feed(&parser, v->frame + at, 1, &msg, &got);
-            if (!got || at != v->len)
+            frame = hiwonder_rrc_parser_frame(&parser, &found);
+            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)
                 hiwonder_rrc__fail(&failed, v->name, "the parser does not find the frame", HIWONDER_RRC_OK);
         }
 #endif

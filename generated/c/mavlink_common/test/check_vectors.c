@@ -49,12 +49,14 @@ int main(void)
 #if MAVLINK_COMMON_ENABLE_PARSER
         if (decodes) {
             mavlink_common_parser_t parser;
-            size_t at = 0;
+            size_t at = 0u, from = 0u, to = v->len, found = 0u;
+            const uint8_t *frame;
             bool got = false;
             mavlink_common_parser_init(&parser, v->direction);
             while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */
                 at += mavlink_common_parser_feed(&parser, v->frame + at, 1, &msg, &got);
-            if (!got || at != v->len)
+            frame = mavlink_common_parser_frame(&parser, &found);
+            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)
                 mavlink_common__fail(&failed, v->name, "the parser does not find the frame", MAVLINK_COMMON_OK);
         }
 #endif

@@ -67,14 +67,16 @@ int main(void)
 #if ROBOCLAW_ENABLE_PARSER
         if (decodes) {
             roboclaw_parser_t parser;
-            size_t at = 0;
+            size_t at = 0u, from = 0u, to = v->len, found = 0u;
+            const uint8_t *frame;
             bool got = false;
             roboclaw_parser_init(&parser, v->direction);
             if (asked)
                 roboclaw_parser_expect_reply(&parser, &req);
             while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */
                 at += roboclaw_parser_feed(&parser, v->frame + at, 1, &msg, &got);
-            if (!got || at != v->len)
+            frame = roboclaw_parser_frame(&parser, &found);
+            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)
                 roboclaw__fail(&failed, v->name, "the parser does not find the frame", ROBOCLAW_OK);
         }
 #endif

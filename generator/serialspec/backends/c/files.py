@@ -1488,6 +1488,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__LENGTHS {all_lengths} /* every layout has a length element */
 #define {P}__SIZED {int(sized)} /* some layout's size follows from its content's leading fields (a size rule) */
 #define {P}__SINGLE {single} /* one layout per direction */
+#define {P}__MOST_LAYOUTS {max(n_layouts.values(), default=1)}u /* the most layouts of a direction */
 #define {P}__TABLES ({P}_ENABLE_ENCODE || {P}__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 /* The directions the build decodes ({P}_ROLE): the other side's is refused before any work, so the compiler leaves
  * its code out; the parser's direction is a constant where the build decodes one. */
@@ -1801,11 +1802,16 @@ void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
  * before it can be judged again, 0 when that is not known), no frame, or corrupt (V_UNKNOWN: a good checksum and an
- * unknown command, its size in *size; judged again each time, so its size is known when it is counted). */
+ * unknown command, its size in *size; judged again each time, so its size is known when it is counted). Where several
+ * layouts fit, the one that completes first and decodes is the frame (Python's FrameStreamParser._sizes): the
+ * complete sizes are tried shortest first, and one that fails leaves the next its chance, or the wait for a layout
+ * still incomplete (RPLIDAR: a 5-byte measurement that fails before the 7-byte scan descriptor at one place). */
 static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 {{
-    uint8_t count = {p}__count({P}__RX(p->dir)), k;
+    uint8_t count = {p}__count({P}__RX(p->dir)), k, i, j, m = 0u;
     size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
+    size_t sizes[{P}__MOST_LAYOUTS] = {{0u}}; /* the complete layouts' sizes, shortest first, each once */
+    size_t unknown = 0u;             /* the first size whose frame has a good checksum and an unknown command */
     int r;
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
@@ -1816,7 +1822,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
             need = 0u;
             continue;
         }}
-        if (s < 0 || (unsigned long)s > {P}_MAX_FRAME) {{
+        if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME) {{ /* (a reply its request sizes at 0 bytes: no frame) */
             continue;
         }}
         if ((size_t)s > p->n - pos) {{
@@ -1825,26 +1831,37 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
             }}
             continue;
         }}
-        r = {decode_rx}(p->buf + pos, (size_t)s, {P}__RX(p->dir), {expect_arg}out);
-        if (r == {P}_E_UNKNOWN) {{
-            *size = (size_t)s;
-            return {P}__V_UNKNOWN;
+        for (i = 0u; i < m && sizes[i] < (size_t)s; i++) {{
         }}
-        if (r != {P}_OK) {{
-            if (need == (size_t)-1) {{
-                p->verdict[pos] = {P}__V_CORRUPT;
-            }}
-            return {P}__V_CORRUPT;
+        if (i < m && sizes[i] == (size_t)s) {{ /* a size already there: the same bytes, the same verdict */
+            continue;
         }}
-        *size = (size_t)s;
-        return {P}__ACCEPT;
+        for (j = m; j > i; j--) {{
+            sizes[j] = sizes[j - 1u];
+        }}
+        sizes[i] = (size_t)s;
+        m++;
+    }}
+    for (i = 0u; i < m; i++) {{
+        r = {decode_rx}(p->buf + pos, sizes[i], {P}__RX(p->dir), {expect_arg}out);
+        if (r == {P}_OK) {{
+            *size = sizes[i];
+            return {P}__ACCEPT;
+        }}
+        if (r == {P}_E_UNKNOWN && unknown == 0u) {{
+            unknown = sizes[i];
+        }}
     }}
     if (need != (size_t)-1) {{
         *size = need;
         return {P}__V_WAIT;
     }}
-    p->verdict[pos] = {P}__V_NONE;
-    return {P}__V_NONE;
+    if (unknown != 0u) {{
+        *size = unknown;
+        return {P}__V_UNKNOWN;
+    }}
+    p->verdict[pos] = m > 0u ? {P}__V_CORRUPT : {P}__V_NONE;
+    return p->verdict[pos];
 }}
 
 /* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */

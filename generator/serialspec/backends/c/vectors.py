@@ -124,10 +124,10 @@ def vectors_header(ctx: Ctx) -> str:
     )
 
 
-def unparsed(protocol: Protocol) -> list[Direction]:
-    """The directions whose frames the parser need not find alone: beside other layouts, one of content alone (no
-    header, no command: RPLIDAR's measurements) takes any bytes as its frame, so a prefix of another frame may come
-    out as one, as the Python parser reads it (the tests hold the C parser to it on streams)."""
+def inner(protocol: Protocol) -> list[Direction]:
+    """The directions where a frame may hold a shorter frame that the parser rightly takes first: beside other
+    layouts, one of content alone (no header, no command: RPLIDAR's measurements) reads a frame from any bytes, so
+    bytes inside an example (a response descriptor's `5A 03 00 00 00`) can be one, as the Python parser reads them."""
     return [
         d
         for d, layouts in protocol.framing.alternatives.items()
@@ -137,14 +137,47 @@ def unparsed(protocol: Protocol) -> list[Direction]:
     ]
 
 
+def first_frame(ctx: Ctx) -> str:
+    """Where a frame may hold a shorter one (`inner`): the function giving the frame the parser must take first from
+    a vector's bytes, by the decoder alone (runtime/stream.py's rule: the valid frame that ends first, of those the
+    one that starts first; the vector itself where no part of it decodes)."""
+    p, P = ctx.p, ctx.P
+    if not inner(ctx.protocol):
+        return ""
+    return (
+        f"#if {P}_ENABLE_PARSER\n"
+        "/* The frame the parser fed v's bytes must take first, by the decoder alone: the valid frame that ends\n"
+        " * first, of those the one that starts first (a layout of content alone reads a frame from bytes inside\n"
+        " * another). */\n"
+        f"static void {p}__first_frame(const {p}_vector_t *v, size_t *from, size_t *to)\n"
+        "{\n"
+        "    size_t end, start;\n"
+        f"    {p}_msg_t msg;\n"
+        "    for (end = 1u; end < v->len; end++) {\n"
+        "        for (start = 0u; start < end; start++) {\n"
+        f"            if ({p}_decode(v->frame + start, end - start, v->direction, &msg) == {P}_OK) {{\n"
+        "                *from = start;\n"
+        "                *to = end;\n"
+        "                return;\n"
+        "            }\n"
+        "        }\n"
+        "    }\n"
+        "    *from = 0u;\n"
+        "    *to = v->len;\n"
+        "}\n"
+        "#endif\n\n"
+    )
+
+
 def check_vectors(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
-    alone = "".join(f" && v->direction != {P}_{d.name}" for d in unparsed(protocol))
-    alone_doc = (
-        "        /* (not where a layout of content alone may take a frame's first bytes, as Python's parser does) */\n"
-        if alone
-        else ""
-    )
+    shorter = " || ".join(f"v->direction == {P}_{d.name}" for d in inner(protocol))
+    if shorter:  # the frame the parser takes first: the vector, or a shorter frame inside it that ends first
+        shorter = (
+            f"            if ({shorter}) {{ /* a frame inside it that ends first is taken first (as in Python) */\n"
+            f"                {p}__first_frame(v, &from, &to);\n"
+            "            }\n"
+        )
     decode = f"        int result = {p}_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);\n"
     encode = f"            result = {p}_encode(&msg, buf, sizeof buf, &len);\n"
     expect = ""
@@ -188,8 +221,7 @@ def check_vectors(ctx: Ctx) -> str:
         "{\n"
         f'    printf("FAIL %s: %s (%s)\\n", name, what, {p}_result_name(result));\n'
         "    (*failed)++;\n"
-        "}\n\n"
-        "int main(void)\n"
+        "}\n\n" + first_frame(ctx) + "int main(void)\n"
         "{\n"
         "    unsigned failed = 0;\n"
         f"    const {p}_vector_t *v;\n"
@@ -219,15 +251,19 @@ def check_vectors(ctx: Ctx) -> str:
         "        }\n"
         "#endif\n"
         "#endif\n"
-        f"#if {P}_ENABLE_PARSER\n" + alone_doc + f"        if (decodes{alone}) {{\n"
+        f"#if {P}_ENABLE_PARSER\n"
+        "        if (decodes) {\n"
         f"            {p}_parser_t parser;\n"
-        "            size_t at = 0;\n"
+        "            size_t at = 0u, from = 0u, to = v->len, found = 0u;\n"
+        "            const uint8_t *frame;\n"
         "            bool got = false;\n"
-        f"            {p}_parser_init(&parser, v->direction);\n"
+        + shorter
+        + f"            {p}_parser_init(&parser, v->direction);\n"
         + expect
         + "            while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */\n"
         f"                at += {p}_parser_feed(&parser, v->frame + at, 1, &msg, &got);\n"
-        "            if (!got || at != v->len)\n"
+        f"            frame = {p}_parser_frame(&parser, &found);\n"
+        "            if (!got || at != to || found != to - from || memcmp(frame, v->frame + from, found) != 0)\n"
         f'                {p}__fail(&failed, v->name, "the parser does not find the frame", {P}_OK);\n'
         "        }\n"
         "#endif\n"

@@ -27,7 +27,7 @@ generate: $(STAMP) test-tools
 # are skipped, saying why.
 # The C target's tests also build with clang, with gcc -m32 (32-bit size_t and long: the 32-bit libc and libgcc,
 # without gcc-multilib, which Debian will not install beside a cross gcc) and for big-endian PowerPC (a cross gcc;
-# qemu-user runs the programs) and are compiled for 8-bit AVR (avr-gcc: a 16-bit int, a 32-bit double): installed
+# qemu-user runs the programs) and for 8-bit AVR (avr-gcc: a 16-bit int, a 32-bit double; simavr runs them): installed
 # the same way, each group on its own, so one that cannot be installed leaves the others. The Arm gcc `make bench-c` measures the C's flash with (gcc-arm-none-eabi, newlib-nano
 # included) is installed by `make bench-tools`: no test needs it.
 TEST_TOOLS := tshark tmux
@@ -54,6 +54,7 @@ test-tools:
 	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing=" libc6-dev-i386 $(LIB32GCC)"; \
 	$(INSTALL_MISSING)
 	@missing=""; command -v avr-gcc >/dev/null || missing=" gcc-avr avr-libc"; \
+	command -v simavr >/dev/null || missing="$$missing simavr"; \
 	$(INSTALL_MISSING)
 
 bench-tools: test-tools

@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import shutil
 import subprocess
 from collections.abc import Iterator
@@ -140,6 +141,7 @@ QEMU_PPC = shutil.which("qemu-ppc")
 # a 32-bit int warns there. Debian's avr-gcc 5.4 knows all of FLAGS but -Wnull-dereference (gcc 6).
 AVR_GCC = shutil.which("avr-gcc")
 AVR_LEAVES_OUT = {"-Wnull-dereference"}
+SIMAVR = shutil.which("simavr")
 
 
 def compiler(build: str) -> list[str]:
@@ -1247,6 +1249,47 @@ def test_example_host_program_talks_to_a_virtual_servo(tmp_path: Path) -> None:
     ping, read = (json.loads(line) for line in run.stdout.splitlines())
     assert ping["fields"] == {"id": 1, "error": 0, "data": ""}
     assert read["command"] == "reply" and len(bytes.fromhex(read["fields"]["data"])) == 6
+
+
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_golden_vectors_pass_on_an_8_bit_avr(g: Generated, tmp_path: Path) -> None:
+    """<protocol>/test/check_vectors.c run on an ATmega1284P (a 16-bit `int`, a 32-bit `double`, 16 KiB of RAM)
+    under simavr, built with the strict warnings: every example decodes to its message, encodes back byte for byte
+    and is found by the parser, as on the host. The group capacities of 32 items are cut to 4 (`-D`, as a firmware
+    author sizes them) so that the largest message fits beside the vectors, which AVR keeps in RAM."""
+    if AVR_GCC is None or SIMAVR is None:
+        pytest.skip("avr-gcc or simavr missing (apt-get install gcc-avr avr-libc simavr; make generate installs them)")
+    name = g.protocol.name
+    folder = GENERATED_C / name
+    if not (folder / "test" / "check_vectors.c").exists():
+        pytest.skip("no golden-vector program (a text protocol's C has none)")
+    header = (folder / f"{name}.h").read_text()
+    capacities = [f"-D{macro}=4" for macro in re.findall(r"#define (\w+_MAX) 32u", header)]
+    flags = [flag for flag in FLAGS if flag not in AVR_LEAVES_OUT]
+    program = [folder / "test" / "check_vectors.c", *sources(g), ROOT / "tests" / "c" / "avr_stdout.c"]
+    elf = tmp_path / "check.elf"
+    built = subprocess.run(
+        [
+            AVR_GCC,
+            "-mmcu=atmega1284p",
+            *flags,
+            "-Os",
+            *capacities,
+            "-I",
+            str(folder),
+            *map(str, program),
+            "-o",
+            str(elf),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert built.returncode == 0 and not built.stderr, built.stderr
+    run = subprocess.run(
+        [SIMAVR, "-m", "atmega1284p", "-f", "16000000", str(elf)], capture_output=True, text=True, timeout=60
+    )
+    printed = re.sub(r"\x1b\[[0-9;]*m", "", run.stdout + run.stderr)  # simavr colours what the UART sends
+    assert re.search(rf"^{name}: \d+ vectors, \d+ refused frames, 0 failed", printed, re.MULTILINE), printed
 
 
 def test_the_avr_example_builds_as_its_comment_says_and_fits_an_arduino_mega(tmp_path: Path) -> None:

@@ -557,6 +557,31 @@ def test_tshark_reads_both_forms_of_the_same_commands(tmp_path: Path) -> None:
 @pytest.mark.skipif(
     TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
 )
+def test_tshark_reads_a_refusal_in_a_layout_of_its_own_after_its_request(tmp_path: Path) -> None:
+    """The STM32 bootloader refuses a request with a NACK (`1F`), a layout of its own that the request's `refused_by`
+    names: after the request it is shown as the NACK, not as bytes outside any frame; the reply itself still is the
+    reply."""
+    assert TSHARK is not None
+    spec = str(ROOT / "tests" / "specs" / "stm32_bootloader.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "refused.capture"
+    capture.write_text(
+        "# serialspec capture: stm32_bootloader\n"
+        "2026-11-25T10:00:00.000000+00:00 request 02 fd\n"
+        "2026-11-25T10:00:00.000100+00:00 response 1f\n"
+        "2026-11-25T10:00:00.000200+00:00 request 02 fd\n"
+        "2026-11-25T10:00:00.000300+00:00 response 79 01 04 10 79\n",
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "refused.pcap"))
+    script = f"lua_script:{tmp_path / 'stm32_bootloader' / 'stm32_bootloader.lua'}"
+    shown = run(TSHARK, "-X", script, "-r", str(tmp_path / "refused.pcap"), "-T", "fields", "-e", "_ws.col.Info")
+    assert shown.split() == ["get_id", "nack", "get_id", "get_id"], shown
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
 def test_tshark_reads_a_reply_with_the_request_before_it(tmp_path: Path) -> None:
     """RoboClaw's replies carry no code and their CRC starts with the request's address and command: a reply before
     any request is one clear note (not garbage, not a guess); after its request it is read in the request's layout,

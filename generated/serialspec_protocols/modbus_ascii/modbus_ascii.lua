@@ -1677,10 +1677,23 @@ end
 -- The size of a frame of `layout` at data[pos], nil when none starts there, false when the packet ends first.
 -- `request`: the last request before it ({message, parts}), nil when none is known; replies that carry no code
 -- (`answers`) are read in the layout of the reply it gets.
+-- The reply a request gets in this layout, where replies are read with their request: its answer, or a reply that
+-- refuses it in a layout of its own (`refused_by`: STM32's NACK); `awaits`: the request names a reply at all.
+local function awaited(direction, layout, request)
+  if not (direction.answers and request) then return nil, false end
+  local answer = direction.answers[request.message.answer]
+  if answer and answer.layout == layout.name then return answer, true end
+  for _, key in ipairs(request.message.refusals or {}) do
+    local refusal = direction.answers[key]
+    if refusal and refusal.layout == layout.name then return refusal, true end
+  end
+  return nil, answer ~= nil
+end
+
 local function frame_size(direction, layout, data, pos, request)
   local available = #data - pos + 1
-  local answer = direction.answers and request and direction.answers[request.message.answer]
-  if answer and answer.layout ~= layout.name then return nil end
+  local answer, awaits = awaited(direction, layout, request)
+  if awaits and answer == nil then return nil end
   local entry, seen, status
   for index = 1, layout.first - 1 do
     local element, offset = layout.elements[index], layout.before[index]

@@ -45,6 +45,7 @@ from serialspec.lang.model import (
     content_bounds,
     discriminator,
     engineering_unit,
+    refusals_of,
     replies_by_request,
     reply_to,
     size_terms,
@@ -334,9 +335,13 @@ def _message(protocol: Protocol, message: Message) -> dict[str, Any]:
     if message.padded is not None:  # truncate: trailing_zeros
         result["padded"] = message.padded
     if message.direction == Direction.REQUEST and protocol.framing.by_request(Direction.RESPONSE):
-        reply = reply_to(message, replies_by_request(protocol.messages()))
+        replies = replies_by_request(protocol.messages())
+        reply = reply_to(message, replies)
         if reply is not None:  # the reply it gets (in `answers`), where replies are read with their request
             result["answer"] = reply.key
+        refusals = [r.key for r in refusals_of(message, replies)]
+        if refusals:  # the replies that refuse it instead (`refused_by`), each maybe in a layout of its own
+            result["refusals"] = refusals
     return result
 
 

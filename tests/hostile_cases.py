@@ -1208,6 +1208,18 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "examples.move_request: the frame decodes to other values: speed is not in the frame",
     ),
     (
+        "a mapping's entries one level too high",  # one mistake, one line (not also one per entry)
+        "tiny",
+        replace_text(
+            "    entries:\n      position: {key: 0, type: u16, range: [0, 1000], default: 0}\n"
+            "      speed: {key: 2, type: u8, range: [0, 100], default: 10}\n      volts: {key: 3, type: u8, access: r}\n",
+            "    position: {key: 0, type: u16, range: [0, 1000], default: 0}\n"
+            "    speed: {key: 2, type: u8, range: [0, 100], default: 10}\n    volts: {key: 3, type: u8, access: r}\n",
+        ),
+        "tables.regs: missing key 'entries': position, speed, volts belong under `entries:` (indent them one level "
+        "below it)",
+    ),
+    (
         "a comma in flow-style text",  # the rest of the text after the comma reads as a key
         "tiny",
         replace_text('unit: "0.1°"', "unit: tenths, of a degree"),

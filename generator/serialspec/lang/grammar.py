@@ -221,11 +221,23 @@ class Obj(Shape):
         if not isinstance(value, dict):
             yield path, f"expected a mapping with keys {', '.join(self.keys)}, got {_kind(value)}"
             return
-        for key in self.required:
-            if key not in value:
+        missing = [key for key in self.required if key not in value]
+        strays = self._strays(value, missing)
+        if strays:  # one mistake, one line: the entries of a mapping written one level too high
+            yield (
+                path,
+                (
+                    f"missing key {missing[0]!r}: {', '.join(map(str, strays))} belong under `{missing[0]}:` "
+                    "(indent them one level below it)"
+                ),
+            )
+        else:
+            for key in missing:
                 yield path, f"missing key {key!r}"
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
+            if shape is None and key in strays:
+                continue
             if shape is None:
                 # no key of the language holds a space or punctuation: such a "key" is most likely the rest of a
                 # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
@@ -234,6 +246,17 @@ class Obj(Shape):
                 yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)}{hint})"
             else:
                 yield from shape.check(item, (*path, key))
+
+    def _strays(self, value: dict[Any, Any], missing: list[str]) -> list[Any]:
+        """The unknown keys of `value` when they are all entries of the one missing key's mapping, as written one
+        level too high (a layout's elements without `elements:`); else none."""
+        if len(missing) != 1 or not isinstance(self.keys[missing[0]], MapOf):
+            return []
+        mapping = self.keys[missing[0]]
+        assert isinstance(mapping, MapOf)
+        strays = [key for key in value if not (isinstance(key, str) and key in self.keys)]
+        fits = all(isinstance(key, str) and not list(mapping.value.check(value[key], ())) for key in strays)
+        return strays if strays and fits else []
 
     def json_schema(self) -> dict[str, Any]:
         return {

@@ -1216,8 +1216,21 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
             "    position: {key: 0, type: u16, range: [0, 1000], default: 0}\n"
             "    speed: {key: 2, type: u8, range: [0, 100], default: 10}\n    volts: {key: 3, type: u8, access: r}\n",
         ),
-        "tables.regs: missing key 'entries': position, speed, volts belong under `entries:` (indent them one level "
-        "below it)",
+        "tables.regs: missing key 'entries': position, speed, volts belong one level lower, under `entries:`",
+    ),
+    (
+        "a request's fields without `fields:`",
+        "tiny",
+        put("commands/status/request", {"angle": "u16", "speed": {"type": "u8"}}),
+        "commands.status.request: angle, speed belong one level lower, under `fields:`",
+    ),
+    (
+        "a misspelt key beside an absent mapping is a misspelling, not a stray entry",
+        "tiny",
+        put("commands/status/request", {"descripton": "Status"}),
+        "commands.status.request.descripton: unknown key 'descripton' (expected one of description, fields, text, "
+        "optional, unsolicited, values_only, answers, error_reply, optional_when, after, request_code, answered_by, "
+        "default, source)",
     ),
     (
         "a comma in flow-style text",  # the rest of the text after the comma reads as a key

@@ -222,17 +222,12 @@ class Obj(Shape):
             yield path, f"expected a mapping with keys {', '.join(self.keys)}, got {_kind(value)}"
             return
         missing = [key for key in self.required if key not in value]
-        strays = self._strays(value, missing)
+        home, strays = self._strays(value, missing)
         if strays:  # one mistake, one line: the entries of a mapping written one level too high
-            yield (
-                path,
-                (
-                    f"missing key {missing[0]!r}: {', '.join(map(str, strays))} belong under `{missing[0]}:` "
-                    "(indent them one level below it)"
-                ),
-            )
-        else:
-            for key in missing:
+            said = f"missing key {home!r}: " if home in missing else ""
+            yield path, f"{said}{', '.join(map(str, strays))} belong one level lower, under `{home}:`"
+        for key in missing:
+            if key != home or not strays:
                 yield path, f"missing key {key!r}"
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
@@ -247,16 +242,40 @@ class Obj(Shape):
             else:
                 yield from shape.check(item, (*path, key))
 
-    def _strays(self, value: dict[Any, Any], missing: list[str]) -> list[Any]:
-        """The unknown keys of `value` when they are all entries of the one missing key's mapping, as written one
-        level too high (a layout's elements without `elements:`); else none."""
-        if len(missing) != 1 or not isinstance(self.keys[missing[0]], MapOf):
-            return []
-        mapping = self.keys[missing[0]]
-        assert isinstance(mapping, MapOf)
+    def _strays(self, value: dict[Any, Any], missing: list[str]) -> tuple[str, list[Any]]:
+        """(the key, the unknown keys of `value`) when those are all entries of the one mapping key they fit, absent
+        here, as written one level too high (a layout's elements without `elements:`, a request's fields without
+        `fields:`); else ("", []). A missing required mapping is tried first, then any absent one: the one whose
+        entries they all are, if exactly one."""
         strays = [key for key in value if not (isinstance(key, str) and key in self.keys)]
-        fits = all(isinstance(key, str) and not list(mapping.value.check(value[key], ())) for key in strays)
-        return strays if strays and fits else []
+        if not strays or not all(isinstance(key, str) and self._entry_like(key, value[key]) for key in strays):
+            return "", []
+        absent = [key for key, shape in self.keys.items() if key not in value and isinstance(shape, MapOf)]
+        for candidates in ([key for key in missing if key in absent], absent):
+            homes = [key for key in candidates if self._holds(key, value, strays)]
+            if len(homes) == 1:
+                return homes[0], strays
+            if homes:
+                return "", []
+        return "", []
+
+    def _entry_like(self, key: str, item: Any) -> bool:
+        """A stray key that may be an entry put one level too high, not a misspelling of one of this mapping's own
+        keys (`descripton: Lamp`): not close to any of them, and holding a mapping or a name (`u8`, a shared
+        field's), not free text."""
+        import difflib  # noqa: PLC0415 (only for a spec with a mistake)
+
+        if difflib.get_close_matches(key, self.keys, n=1, cutoff=0.75):
+            return False
+        return isinstance(item, dict) or (
+            isinstance(item, str) and re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", item) is not None
+        )
+
+    def _holds(self, key: str, value: dict[Any, Any], strays: list[Any]) -> bool:
+        """Every stray key's value is an entry the mapping `key` takes."""
+        mapping = self.keys[key]
+        assert isinstance(mapping, MapOf)
+        return not mapping.int_keys and all(not list(mapping.value.check(value[k], ())) for k in strays)
 
     def json_schema(self) -> dict[str, Any]:
         return {

@@ -259,6 +259,12 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("commands/move/code", "one"),
         "commands.move.code: expected an integer, got text (text codes belong to `framing: {kind: text}`)",
     ),
+    (
+        "code as a number in quotes",  # YAML reads "0x01" as text
+        "tiny",
+        put("commands/move/code", "0x01"),
+        "commands.move.code: expected an integer, got text (write it without quotes: 0x01)",
+    ),
     ("code true", "tiny", put("commands/move/code", True), "commands.move.code: expected an integer, got true/false"),
     (
         "code float",
@@ -1194,6 +1200,13 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("examples/move_request/fields/mode", "fast"),
         "examples.move_request: the frame decodes to other values: mode is 1, not 'fast' (examples record wire values: "
         "write 1, which is fast)",
+    ),
+    (
+        "example given as `frame` without `printed`",  # what a newcomer writes first
+        "tiny",
+        rename("examples/move_request/printed", "frame"),
+        "examples.move_request: missing key 'printed' (the frame as the document prints it, e.g. `printed: AA 01 02 "
+        "01 32 DE`; `frame` only where the bytes sent differ from it)",
     ),
     (
         "example value missing",

@@ -216,6 +216,8 @@ class Obj(Shape):
     # more examples for the language reference, beyond the shipped specs': (label, YAML under the parent key, a
     # line that works it through) for each documented variant (the transforms' samples)
     variants: tuple[tuple[str, dict[str, Any], str], ...] = ()
+    # what the line saying a required key is missing adds, by key (what a newcomer writes in its place)
+    missing_hints: dict[str, str] = field(default_factory=dict)
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, dict):
@@ -228,7 +230,8 @@ class Obj(Shape):
             yield path, f"{said}{', '.join(map(str, strays))} belong one level lower, under `{home}:`"
         for key in missing:
             if key != home or not strays:
-                yield path, f"missing key {key!r}"
+                hint = f" ({self.missing_hints[key]})" if key in self.missing_hints else ""
+                yield path, f"missing key {key!r}{hint}"
         for key, item in value.items():
             shape = self.keys.get(key) if isinstance(key, str) else None
             if shape is None and key in strays:
@@ -1680,6 +1683,11 @@ EXAMPLE = Obj(
     },
     required=("source", "direction", "printed", "command", "fields"),
     description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
+    missing_hints={
+        "printed": "the frame as the document prints it, e.g. `printed: AA 01 02 01 32 DE`; `frame` only where the "
+        "bytes sent differ from it",
+        "fields": "the field values the frame carries; `fields: {}` for a message without fields",
+    },
 )
 
 ERRATUM = Obj(

@@ -415,7 +415,13 @@ class Commands(FieldResolver):
         elif probe and "response" not in value and "answered_by" not in (value["request"] or {}):
             self.error((*path, "probe"), "a probe needs a reply: a `response`, or `answered_by` on its request")
         if isinstance(value.get("code"), str):
-            self.error((*path, "code"), "expected an integer, got text (text codes belong to `framing: {kind: text}`)")
+            code = value["code"].strip()
+            try:  # a number in quotes ("0x01"): YAML reads it as text
+                hint = f"write it without quotes: {code}" if int(code, 0) >= 0 else ""
+            except ValueError:
+                hint = ""
+            hint = hint or "text codes belong to `framing: {kind: text}`"
+            self.error((*path, "code"), f"expected an integer, got text ({hint})")
         return Command(
             name=name,
             code=value.get("code"),

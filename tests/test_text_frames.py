@@ -542,3 +542,38 @@ def test_verbs_that_address_devices_by_id_refuse_a_text_protocol_in_one_line(ver
     )
     assert result.returncode != 0
     assert result.stderr.count("\n") == 1 and "is a text protocol" in result.stderr, result.stderr
+
+
+def test_a_field_refused_is_not_refused_again_where_the_device_names_it() -> None:
+    """One mistake, one line: a response field of an unknown type is refused where it is declared, not again as "has
+    no field" where the device reports it; what the device reports it from is still checked (a second mistake, its
+    own line)."""
+    from serialspec.lang import SpecErrors
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    spec = """
+protocol: psu
+title: Bench supply
+serial: {baudrate: 9600}
+framing: {kind: text, end: "\\r\\n", separator: " "}
+commands:
+  voltage:
+    code: "VOLT?"
+    request: {}
+    response: {fields: {volts: {type: float}}}
+  set_voltage:
+    code: VOLT
+    request: {fields: {volts: {type: decimal, precision: 2, range: [0, 30]}}}
+device:
+  state: {volts: 5}
+  commands:
+    set_voltage: {stores: {volts: volts}}
+    voltage: {reports: {volts: volt}}
+"""
+    with pytest.raises(SpecErrors) as error:
+        resolve(load_text(spec, "psu.yaml"))
+    lines = str(error.value).splitlines()
+    assert len(lines) == 2, lines
+    assert "commands.voltage.response.fields.volts: unknown text field type 'float'" in lines[0]
+    assert "device.commands.voltage.reports.volts: unknown name 'volt' (not a state variable)" in lines[1]

@@ -439,6 +439,14 @@ class TextPass(Pass):
             if not layout.separator and (not label or set(label) & set("0123456789+-.")):
                 self.error((*path[:-1], "fields"), f"label {label!r} holds a number's character: it could be a value")
 
+    def declared(self, message: TextMessage) -> set[str]:
+        """The field names the spec gives a message, resolved or not: a reference to one that did not resolve is
+        not a second mistake (its own line says why)."""
+        command = (self.ctx.data.get("commands") or {}).get(message.key)
+        part = command.get(message.direction.value) if isinstance(command, dict) else None
+        fields = part.get("fields") if isinstance(part, dict) else None
+        return {str(name) for name in fields} if isinstance(fields, dict) else set()
+
     def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:
         found: list[TextField | TextRepeat] = []
         for name, value in raw.items():
@@ -580,7 +588,10 @@ class TextPass(Pass):
             for name, source in (item.get("values") or {}).items():
                 at = (*where, "values", name)
                 if name not in fields:
-                    self.error(at, f"{key} has no field {name!r}")
+                    if name not in self.declared(message):
+                        self.error(at, f"{key} has no field {name!r}")
+                    else:  # a field its own line refused: its value is still checked
+                        self.of_state(source, at, state)
                     continue
                 parsed = self.of_state(source, at, state)
                 if parsed is not None:
@@ -647,7 +658,8 @@ class TextPass(Pass):
             stores = {}
             for name, variable in (item.get("stores") or {}).items():
                 if name not in asked:
-                    self.error((*where, "stores", name), f"{key}'s request has no field {name!r}")
+                    if name not in self.declared(request):  # else its own line said why it is not a field
+                        self.error((*where, "stores", name), f"{key}'s request has no field {name!r}")
                 elif str(variable) not in state:
                     self.error((*where, "stores", name), f"unknown state variable {variable!r}")
                 else:
@@ -664,7 +676,10 @@ class TextPass(Pass):
             for name, source in (item.get("reports") or {}).items():
                 at = (*where, "reports", name)
                 if name not in answered:
-                    self.error(at, f"{key}'s response has no field {name!r}")
+                    if response is None or name not in self.declared(response):
+                        self.error(at, f"{key}'s response has no field {name!r}")
+                    else:  # a field its own line refused: what it reports is still checked
+                        self.of_state(source, at, state)
                     continue
                 parsed = self.of_state(source, at, state)
                 if parsed is not None:

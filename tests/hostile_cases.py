@@ -1241,7 +1241,8 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "a misspelt key beside an absent mapping is a misspelling, not a stray entry",
         "tiny",
         put("commands/status/request", {"descripton": "Status"}),
-        "commands.status.request.descripton: unknown key 'descripton' (expected one of description, fields, text, "
+        "commands.status.request.descripton: unknown key 'descripton' (did you mean 'description'? expected one of "
+        "description, fields, text, "
         "optional, unsolicited, values_only, answers, error_reply, optional_when, after, request_code, answered_by, "
         "default, source)",
     ),

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import field
 from typing import Any, assert_never
 
@@ -208,6 +208,16 @@ class MapOf(Shape):
         }
 
 
+def _did_you_mean(key: object, keys: Iterable[str]) -> str:
+    """ "did you mean 'range'? " for a key one or two letters from one of `keys` (`rnage`), else ""."""
+    if not isinstance(key, str):
+        return ""
+    import difflib  # noqa: PLC0415 (only for a spec with a mistake)
+
+    close = difflib.get_close_matches(key, list(keys), n=1, cutoff=0.75)
+    return f"did you mean {close[0]!r}? " if close else ""
+
+
 @mutable
 class Obj(Shape):
     keys: dict[str, Shape]
@@ -241,7 +251,11 @@ class Obj(Shape):
                 # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
                 cut = isinstance(key, str) and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", key)
                 hint = "; a comma inside `{...}` ends a value: quote text that holds one" if cut else ""
-                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)}{hint})"
+                yield (
+                    (*path, key),
+                    f"unknown key {key!r} ({_did_you_mean(key, self.keys)}expected one of "
+                    + (f"{', '.join(self.keys)}{hint})"),
+                )
             else:
                 yield from shape.check(item, (*path, key))
 

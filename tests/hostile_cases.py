@@ -260,6 +260,14 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.code: expected an integer, got text (text codes belong to `framing: {kind: text}`)",
     ),
     (
+        "a C type name",  # what a datasheet or a C header says
+        "tiny",
+        put("commands/move/request/fields/time/type", "uint16_t"),
+        "commands.move.request.fields.time.type: unknown type 'uint16_t' (did you mean 'u16'? expected one of u8, i8, "
+        "u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, "
+        "table_block, or uN/iN of 1..64 bits)",
+    ),
+    (
         "code as a number in quotes",  # YAML reads "0x01" as text
         "tiny",
         put("commands/move/code", "0x01"),
@@ -743,7 +751,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "type typo",
         "tiny",
         put("commands/move/request/fields/extra", "uint16"),
-        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, uN/iN of 1..64 bits, or a field from `fields:`)",
+        "commands.move.request.fields.extra: unknown type 'uint16' (did you mean 'u16'? expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, uN/iN of 1..64 bits, or a field from `fields:`)",
     ),
     (
         "frame element flags typo",

@@ -50,6 +50,45 @@ class SpecErrors(Exception):
         super().__init__("\n".join(shown(self.errors)))
 
 
+# Type names of other languages and tools, as a newcomer writes them: the language's own
+_OTHER_TYPE_NAMES = {
+    "byte": "u8",
+    "char": "i8",
+    "short": "i16",
+    "word": "u16",
+    "int": "i32",
+    "long": "i32",
+    "dword": "u32",
+    "float": "f32",
+    "single": "f32",
+    "real": "f32",
+    "double": "f64",
+}
+
+
+def type_hint(name: object) -> str:
+    """ "did you mean 'u8'? " for a type written as C, numpy or a datasheet writes it (uint8_t, int16, UINT32,
+    float, double), "a u8 with `range: [0, 1]`, or a bit field: " for bool; else ""."""
+    import re  # noqa: PLC0415 (only for a spec with a mistake)
+
+    if not isinstance(name, str):
+        return ""
+    word = name.strip().lower().removeprefix("unsigned ").replace(" ", "")
+    if word in ("bool", "boolean"):
+        return "a flag is a u8 with `range: [0, 1]`, or a bit field (`bits:`); "
+    found = re.fullmatch(r"(u|s)?int(\d+)(_t)?", word) or re.fullmatch(r"(u|i|s)(\d+)", word)
+    if found and 1 <= int(found[2]) <= 64:
+        sign = "u" if found[1] == "u" or name.strip().lower().startswith("unsigned") else "i"
+        return f"did you mean '{sign}{found[2]}'? "
+    found = re.fullmatch(r"float(32|64)(_t)?", word)
+    if found:
+        return f"did you mean 'f{found[1]}'? "
+    own = _OTHER_TYPE_NAMES.get(word)
+    if own and name.strip().lower().startswith("unsigned") and own[0] == "i":
+        own = "u" + own[1:]
+    return f"did you mean {own!r}? " if own else ""
+
+
 def shown(errors: Sequence[SpecError]) -> list[str]:
     """The lines that report mistakes to people: the first MAX_SHOWN, then one counting the others."""
     lines = [str(e) for e in errors[:MAX_SHOWN]]

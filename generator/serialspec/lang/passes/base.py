@@ -16,7 +16,7 @@ from typing import Any, Literal
 
 from serialspec.encodings import seven_bit
 from serialspec.lang import grammar
-from serialspec.lang.errors import SpecError, listed
+from serialspec.lang.errors import SpecError, listed, type_hint
 from serialspec.lang.frozen import mutable
 from serialspec.lang.loader import Located, Path, dotted
 from serialspec.lang.model import (
@@ -344,7 +344,7 @@ class Pass:
         found = SCALARS.get(value) if isinstance(value, str) and value in names else None
         if found is None or (found.is_float and not allow_float):
             choices = [n for n in names if allow_float or not SCALARS[n].is_float]
-            raise self.fail(path, f"unknown type {value!r} (expected one of {', '.join(choices)})")
+            raise self.fail(path, f"unknown type {value!r} ({type_hint(value)}expected one of {', '.join(choices)})")
         return found
 
     def stored(self, scalar: ScalarType, sign_magnitude: bool, path: Path) -> ScalarType:

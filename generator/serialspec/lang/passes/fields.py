@@ -8,7 +8,7 @@ from typing import Any, Literal
 
 from serialspec.encodings import bit_run, seven_bit, varint
 from serialspec.lang import counts, expression, grammar
-from serialspec.lang.errors import listed
+from serialspec.lang.errors import listed, type_hint
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     MAX_FIXED_SIZE,
@@ -206,8 +206,8 @@ class FieldResolver(Pass):
                 return self.expand(self.shared_fields[item], ("fields", item))
             raise self.fail(
                 path,
-                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, uN/iN of 1..64 bits, or a field "
-                "from `fields:`)",
+                f"unknown type {item!r} ({type_hint(item)}expected one of {', '.join(FIELD_KINDS)}, uN/iN of 1..64 "
+                "bits, or a field from `fields:`)",
             )
         if not isinstance(item, dict):
             raise Bad  # neither a type name nor a mapping: the structural check has said so
@@ -363,7 +363,9 @@ class FieldResolver(Pass):
                 **common, table=table, class_name=class_name, entries=entries, endian=endian, struct_name=struct_name
             )
         kinds = ", ".join(FIELD_KINDS)
-        raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {kinds}, or uN/iN of 1..64 bits)")
+        raise self.fail(
+            (*path, "type"), f"unknown type {kind!r} ({type_hint(kind)}expected one of {kinds}, or uN/iN of 1..64 bits)"
+        )
 
     def pad(self, pad: Any, size: Any, path: Path) -> int | None:
         """The pad byte of a fixed-size string, from its hex ('00')."""

@@ -118,6 +118,18 @@ def test_a_reply_any_number_of_times_before_the_end(module: ModuleType, answer: 
     assert isinstance(found, tuple) and [ap.ssid for ap in found] == ssids
 
 
+def test_replies_without_the_line_that_ends_them_time_out_saying_so(module: ModuleType) -> None:
+    from pty_pair import answering_line
+    from serialspec.runtime.errors import Timeout
+
+    with (
+        answering_line(b"AT+CWLAP\r\n", b"+CWLAP:lab\r\n") as name,
+        module.Client(name) as client,
+        pytest.raises(Timeout, match=r"its reply came, but not the 'OK' that ends the answer"),
+    ):
+        client.list_access_points(timeout=0.5)
+
+
 @pytest.mark.parametrize(
     ("answer", "raised"),
     [

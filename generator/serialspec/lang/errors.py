@@ -73,18 +73,20 @@ def type_hint(name: object) -> str:
 
     if not isinstance(name, str):
         return ""
-    word = name.strip().lower().removeprefix("unsigned ").replace(" ", "")
+    lowered = name.strip().lower()
+    unsigned = lowered.startswith("unsigned")
+    word = lowered.removeprefix("unsigned ").replace(" ", "")
     if word in ("bool", "boolean"):
         return "a flag is a u8 with `range: [0, 1]`, or a bit field (`bits:`); "
     found = re.fullmatch(r"(u|s)?int(\d+)(_t)?", word) or re.fullmatch(r"(u|i|s)(\d+)", word)
     if found and 1 <= int(found[2]) <= 64:
-        sign = "u" if found[1] == "u" or name.strip().lower().startswith("unsigned") else "i"
+        sign = "u" if found[1] == "u" or unsigned else "i"
         return f"did you mean '{sign}{found[2]}'? "
     found = re.fullmatch(r"float(32|64)(_t)?", word)
     if found:
         return f"did you mean 'f{found[1]}'? "
     own = _OTHER_TYPE_NAMES.get(word)
-    if own and name.strip().lower().startswith("unsigned") and own[0] == "i":
+    if own and unsigned and own[0] == "i":
         own = "u" + own[1:]
     return f"did you mean {own!r}? " if own else ""
 

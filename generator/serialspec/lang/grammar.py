@@ -280,9 +280,7 @@ class Obj(Shape):
         """A stray key that may be an entry put one level too high, not a misspelling of one of this mapping's own
         keys (`descripton: Lamp`): not close to any of them, and holding a mapping or a name (`u8`, a shared
         field's), not free text."""
-        import difflib  # noqa: PLC0415 (only for a spec with a mistake)
-
-        if difflib.get_close_matches(key, self.keys, n=1, cutoff=0.75):
+        if _did_you_mean(key, self.keys):
             return False
         return isinstance(item, dict) or (
             isinstance(item, str) and re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", item) is not None

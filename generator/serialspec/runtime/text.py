@@ -1365,7 +1365,7 @@ class TextClient:
                     else:
                         self._unread.append(arrived)
             late = Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
-            if answer is not None and final is not None:  # the reply came: say what did not
+            if (answer is not None or replies) and final is not None:  # the reply came: say what did not
                 late.args = (
                     f"{message.COMMAND} ({message.CODE}): its reply came, but not the {final.CODE!r} that ends the "
                     f"answer within {timeout * 1000:.0f} ms",

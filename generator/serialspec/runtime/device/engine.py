@@ -822,7 +822,8 @@ class Engine(FaultInjection):
                 command.final,
                 {name: self.spec.reply.get(name, command.blanks.get(name)) for name in field_keys(command.final)},
             )
-            reply = None if ending is None else reply + ending
+            if ending is not None:  # (one that cannot be encoded is logged; the reply still goes)
+                reply += ending
         return reply
 
     # --- data spaces and error replies ------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from typing import Any
 from serialspec.backends import Unsupported
 from serialspec.backends.common.render import render
 from serialspec.backends.common.text import collapse
-from serialspec.backends.common.text_frames import refuse_text_frames
+from serialspec.backends.common.text_frames import WIRESHARK_TAKES, refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
 from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
 
@@ -19,7 +19,7 @@ def _field(f: TextField) -> dict[str, Any]:
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
-    refuse_text_frames(text)
+    refuse_text_frames(text, WIRESHARK_TAKES)
     messages: dict[str, dict[str, Any]] = {}
     for m in text.messages:
         fields = [
@@ -28,7 +28,14 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
             else _field(item)
             for item in m.fields
         ]
-        entry = {"command": m.key, "direction": m.direction.value, "title": m.title, "fields": fields}
+        entry: dict[str, Any] = {
+            "command": m.key,
+            "code": m.code,
+            "direction": m.direction.value,
+            "title": m.title,
+            "fields": fields,
+            "bare": m.values_only or None,  # read only right after its request (the last one before it in the capture)
+        }
         messages.setdefault(m.code, {})[m.direction.value] = entry
     for by_direction in messages.values():
         if len(by_direction) == 1:  # the code says the direction (runtime/text.py TextFraming.sentence)
@@ -44,10 +51,17 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
     data = {
         "name": protocol.name,
         "title": protocol.title,
-        "start": text.start,
+        # the framing's own text as bytes (a line ending may hold bytes above 0x7F: Nextion's FF FF FF); each
+        # direction's own where it has one (nil: the requests')
+        "start": text.start.encode("latin-1"),
+        "response_start": text.response_start.encode("latin-1") or None,
         "separator": text.separator,
         "marker": text.marker,
-        "ending": text.end,
+        "ending": text.end.encode("latin-1"),
+        "response_ending": text.response_end.encode("latin-1") or None,
+        "decimal": text.checksum_format == "decimal",
+        "checksummed": {d: True for d in text.checksum_directions},
+        "separated": {d: True for d in text.checksum_separated},
         "digits": text.digits,
         "talker": text.talker,
         "required": text.required,

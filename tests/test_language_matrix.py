@@ -2474,7 +2474,8 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
 
 def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
     """A `text` field's `size: rest` (Marlin's `Error:checksum mismatch, Last Line: 122`): the rest of the line,
-    separators included, in a plain message and in one found by its code; C and Wireshark refuse it in one line; the
+    separators included, in a plain message and in one found by its code; C refuses it in one line, Wireshark the
+    one found by its code (tests/test_wireshark_text.py holds its dissector of the plain one to decode); the
     reference says so; round trips, with separators and the layout's own characters in the text; misplaced, refused."""
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["note"] = {
@@ -2489,7 +2490,13 @@ def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
             "fields": {"msg": {"type": "text", "size": "rest"}},
         },
     }
-    files = python_and_markdown(case, r"^a text field to the end of the line \(`size: rest`\)$")
+    files = python_and_markdown(
+        case,
+        {
+            "c": r"^a text field to the end of the line \(`size: rest`\)$",
+            "wireshark": r"^a message's own text layout \(`text:`\)$",  # the error's `after_code` (the note: taken)
+        },
+    )
     assert "text (the rest of the line, separators included)" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

@@ -18,6 +18,7 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.text import TextField
 from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
 from test_language_matrix import TEXT_CASE
 from test_text_frames import sentence_values
@@ -114,11 +115,16 @@ def test_tshark_shows_random_sentences_as_decode_does(name: str, tmp_path: Path)
 # What the C target does not take but the dissector does, each beside the others: every line a frame (no start
 # character, CR LF, an optional XOR checksum in decimal after a separator in requests, a reply of values alone
 # read after its request: the C's lines case), and a start, line ending and checksum of each direction's own (LSS's
-# `#` and `*`, a reply ended by bytes above 0x7F as Nextion's, a checksum in requests alone).
+# `#` and `*`, a reply ended by bytes above 0x7F as Nextion's, a checksum in requests alone; a text to the end of
+# the line).
 ONE_WAY = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_one_way"}
 ONE_WAY["framing"]["start"] = {"request": "#", "response": "*"}
 ONE_WAY["framing"]["end"] = {"request": "\n", "response": "\r\xff\xff\xff"}
 ONE_WAY["framing"]["checksum"]["directions"] = ["request"]
+ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators and all
+    "code": "NT",
+    "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+}
 BY_DIRECTION = {"ws_text_lines": copy.deepcopy(LINES) | {"protocol": "ws_text_lines"}, "ws_text_one_way": ONE_WAY}
 
 
@@ -149,6 +155,9 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
         frames, wanted, asked = [], [], None
         for s in framing.sentences:
             values = data.draw(sentence_values(s))
+            for item in s.fields:  # a text to the end of the line holds separators
+                if isinstance(item, TextField) and item.rest:
+                    values[item.name] = f"a{framing.separator}b {framing.separator}{values[item.name] or ''}"
             talker = data.draw(st.sampled_from(talkers))
             frame = framing.encode(s.code, values, talker, direction=s.direction)
             frames.append((s.direction, frame))

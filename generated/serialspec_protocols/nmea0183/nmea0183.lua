@@ -310,6 +310,10 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
           at = at + 1
         end
       end
+    elseif item.rest then -- the rest of the line, separators included
+      local part = parts[at] and {parts[at][1], data:sub(parts[at][1], stop)} or nil
+      add_field(root, tvb, item.pf, part)
+      at = math.max(at + 1, #parts + 1)
     else
       add_field(root, tvb, item.pf, parts[at])
       at = at + 1

@@ -11,7 +11,17 @@ from serialspec.lang.model import TextField, TextFrame
 # what of the list each target generates
 C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end"})
 WIRESHARK_TAKES = frozenset(
-    {"lines", "decimal", "separated", "values_only", "high_end", "end_by_direction", "start_by_direction", "one_way"}
+    {
+        "lines",
+        "decimal",
+        "separated",
+        "values_only",
+        "high_end",
+        "end_by_direction",
+        "start_by_direction",
+        "one_way",
+        "rest",
+    }
 )
 
 
@@ -20,12 +30,12 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "end_by_direction" and "start_by_direction": a line ending or start of its own for each
-    direction, "one_way": a checksum in one direction only)."""
+    direction, "one_way": a checksum in one direction only, "rest": a text field to the end of the line)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
-    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
+    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields) and "rest" not in takes:
         raise Unsupported("a text field to the end of the line (`size: rest`)")
     if text.response_end and "end_by_direction" not in takes:
         raise Unsupported("a line ending of its own for each direction (`end: {request: ..., response: ...}`)")

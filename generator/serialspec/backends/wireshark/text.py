@@ -15,7 +15,8 @@ from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
 
 
 def _field(f: TextField) -> dict[str, Any]:
-    return {"name": f.name, "title": f.name}
+    # `rest`: the rest of the line, separators included (the message's last field)
+    return {"name": f.name, "title": f.name, "rest": f.rest or None}
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:

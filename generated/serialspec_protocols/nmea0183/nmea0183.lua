@@ -21,6 +21,7 @@ local SPEC = {
   separated = {},
   digits = 2,
   talker = 2,
+  address = false,
   required = false,
   checksum = {algorithm = "xor", invert = false, little = false},
   messages = {
@@ -274,6 +275,12 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
       root:add_proto_expert_info(e_malformed, "no checksum")
     end
   end
+  local address_part = nil -- the framing's address: its digits, right after the start
+  if SPEC.address then
+    local digits = body
+    while digits <= stop and data:byte(digits) >= 48 and data:byte(digits) <= 57 do digits = digits + 1 end
+    address_part, body = {body, data:sub(body, digits - 1)}, digits
+  end
   local parts = split(data, body, stop)
   local address = parts[1][2]
   local talker, code = address:sub(1, SPEC.talker), address:sub(SPEC.talker + 1)
@@ -310,6 +317,8 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
           at = at + 1
         end
       end
+    elseif item.address then -- read before the code
+      add_field(root, tvb, item.pf, address_part)
     elseif item.rest then -- the rest of the line, separators included
       local part = parts[at] and {parts[at][1], data:sub(parts[at][1], stop)} or nil
       add_field(root, tvb, item.pf, part)

@@ -21,6 +21,7 @@ WIRESHARK_TAKES = frozenset(
         "start_by_direction",
         "one_way",
         "rest",
+        "address",
     }
 )
 
@@ -30,7 +31,8 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "end_by_direction" and "start_by_direction": a line ending or start of its own for each
-    direction, "one_way": a checksum in one direction only, "rest": a text field to the end of the line)."""
+    direction, "one_way": a checksum in one direction only, "rest": a text field to the end of the line,
+    "address": an address before the text code)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -54,5 +56,5 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")
     if text.response_start and "start_by_direction" not in takes:
         raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
-    if text.address is not None:
+    if text.address is not None and "address" not in takes:
         raise Unsupported("an address before the text code (`framing.address`)")

@@ -16,7 +16,8 @@ from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
 
 def _field(f: TextField) -> dict[str, Any]:
     # `rest`: the rest of the line, separators included (the message's last field)
-    return {"name": f.name, "title": f.name, "rest": f.rest or None}
+    # `address`: the framing's, every message's first field, its digits right after the start (LSS's servo id)
+    return {"name": f.name, "title": f.name, "rest": f.rest or None, "address": f.address or None}
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
@@ -65,6 +66,7 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         "separated": {d: True for d in text.checksum_separated},
         "digits": text.digits,
         "talker": text.talker,
+        "address": text.address is not None,
         "required": text.required,
         "checksum": checksum,
         "messages": messages,

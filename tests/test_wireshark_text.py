@@ -115,14 +115,15 @@ def test_tshark_shows_random_sentences_as_decode_does(name: str, tmp_path: Path)
 # What the C target does not take but the dissector does, each beside the others: every line a frame (no start
 # character, CR LF, an optional XOR checksum in decimal after a separator in requests, a reply of values alone
 # read after its request: the C's lines case), and a start, line ending and checksum of each direction's own (LSS's
-# `#` and `*` with the servo id before the code, a reply ended by bytes above 0x7F as Nextion's, a checksum in
-# requests alone; a text to the end of the line).
+# `#` and `*` with the servo id before the code, a reply ended by bytes above 0x7F as Nextion's under a code of its
+# own, a checksum in requests alone; a text to the end of the line).
 ONE_WAY = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_one_way"}
 ONE_WAY["framing"]["start"] = {"request": "#", "response": "*"}
 ONE_WAY["framing"]["end"] = {"request": "\n", "response": "\r\xff\xff\xff"}
 ONE_WAY["framing"]["checksum"]["directions"] = ["request"]
 ONE_WAY["framing"]["address"] = "unit"  # LSS's servo id: `#5QD` asked, `*5QD1800` answered
 ONE_WAY["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
+ONE_WAY["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}  # a reply under a code of its own
 ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators and all
     "code": "NT",
     "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},

@@ -136,6 +136,7 @@ local SPEC = {
       only = "response",
     },
   },
+  alone = {},
 }
 
 -- bit operations (Lua 5.2's bit32, or 5.3's operators) and the mask of a width, for the checksums' Lua code
@@ -212,10 +213,11 @@ CHECKSUMS["xor"] = function(spec, size, data)
 end
 
 -- the fields of a sentence's body after the address: {start, text} each (start: offset in the packet, 0-based)
-local function split(data, first, last)
+local function split(data, first, last, separator)
+  separator = separator or SPEC.separator
   local parts, at = {}, first
   while true do
-    local stop = data:find(SPEC.separator, at, true)
+    local stop = data:find(separator, at, true)
     if stop == nil or stop > last then
       parts[#parts + 1] = {at, data:sub(at, last)}
       return parts
@@ -223,6 +225,26 @@ local function split(data, first, last)
     parts[#parts + 1] = {at, data:sub(at, stop - 1)}
     at = stop + 1
   end
+end
+
+-- the message found by its own code at data[first..last] (the talker left out: an ELM327's `41 0C`, the longest
+-- code that fits, then its `after_code` and its own ending), its fields' parts and where they end; nil: none fits
+local function found_alone(data, first, last, direction)
+  local text = data:sub(first, last)
+  for _, item in ipairs(SPEC.alone) do
+    if item.direction == direction and text:sub(1, #item.code) == item.code then
+      local message = SPEC.messages[item.code][direction]
+      local layout, rest = message.layout, text:sub(#item.code + 1)
+      if rest == "" then return message, {}, last end
+      if rest:sub(1, #layout.after) == layout.after
+        and (layout.ending == "" or rest:sub(-#layout.ending) == layout.ending) then
+        local inner_first, inner_last = first + #item.code + #layout.after, last - #layout.ending
+        if inner_last < inner_first then return message, {}, inner_last end
+        return message, split(data, inner_first, inner_last, layout.separator), inner_last
+      end
+    end
+  end
+  return nil
 end
 
 local function add_field(tree, tvb, pf, part)
@@ -288,8 +310,18 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
   local message = by_direction and by_direction[by_direction.only or direction]
   local bare = asked and SPEC.messages[asked] and SPEC.messages[asked].response
   local coded = by_direction and by_direction[direction] and not by_direction[direction].bare
-  local at = 2
-  if direction == "response" and bare and bare.bare and not coded then
+  local plain = coded and not by_direction[direction].layout -- a code of the framing's own text
+  local head, head_size = parts[1][1], #address -- talker and code, shown under the command's name
+  local at, own, own_parts, own_last = 2, nil, nil, nil
+  if #SPEC.alone > 0 and not plain then
+    own, own_parts, own_last = found_alone(data, body + SPEC.talker, stop, direction)
+  end
+  if own then -- found by its own code: its fields after it
+    local at_code = parts[1][1] + SPEC.talker
+    if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, SPEC.talker), talker) end
+    root:add(f_code, tvb(at_code - 1, #own.code), own.code)
+    message, parts, stop, at, head_size = own, own_parts, own_last, 1, SPEC.talker + #own.code
+  elseif direction == "response" and bare and bare.bare and not coded then
     message, at = bare, 1 -- a reply of values alone, right after its request: every part a field
   elseif message == nil then
     root:add(f_code, tvb(parts[1][1] - 1, #address), code)
@@ -300,8 +332,8 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
     if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, #talker), talker) end
     root:add(f_code, tvb(parts[1][1] - 1 + #talker, #code), code)
   end
-  root:add(f_command, tvb(parts[1][1] - 1, #address), message.command)
-  root:add(f_direction, tvb(parts[1][1] - 1, #address), message.direction)
+  root:add(f_command, tvb(head - 1, head_size), message.command)
+  root:add(f_direction, tvb(head - 1, head_size), message.direction)
   root:set_text(string.format("%s %s %s%s", SPEC.title, message.direction, message.title,
     checked == false and " [bad checksum]" or ""))
   info[#info + 1] = message.command

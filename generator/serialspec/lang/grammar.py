@@ -724,8 +724,7 @@ TEXT_LAYOUT = Obj(
             'own (an ELM327 answers `010C` with `41 0C 1A F8`: `response: {text: {code: "41 0C"}}`; an AT modem '
             'answers `AT+CSQ` with `+CSQ: 20,99`: `text: {code: "+CSQ:", after_code: " "}`). It may hold '
             "the message's separator (several words); the message is found by it, the longest code that fits, and "
-            "clients and the simulator pair it with its request as usual. The C target and the Wireshark dissector "
-            "refuse it, saying so.",
+            "clients and the simulator pair it with its request as usual. The C target refuses it, saying so.",
             example="41 0C",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
@@ -1650,8 +1649,7 @@ FRAMING = Obj(
             "zero-padded to `width` digits, "
             "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
             "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it refuses line "
-            "endings by direction and reply codes of their own, one line each; the Wireshark dissector, reply codes "
-            "of their own.",
+            "endings by direction and reply codes of their own, one line each.",
         ),
     ),
 )

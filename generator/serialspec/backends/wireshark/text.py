@@ -11,7 +11,7 @@ from serialspec.backends.common.render import render
 from serialspec.backends.common.text import collapse
 from serialspec.backends.common.text_frames import WIRESHARK_TAKES, refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
-from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
 
 def _field(f: TextField) -> dict[str, Any]:
@@ -23,6 +23,7 @@ def _field(f: TextField) -> dict[str, Any]:
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
     refuse_text_frames(text, WIRESHARK_TAKES)
     messages: dict[str, dict[str, Any]] = {}
+    alone: list[TextMessage] = []  # the messages found by their own code, the longest code first
     for m in text.messages:
         fields = [
             {"name": item.name, "count": item.count, "max": item.max_count, "fields": [_field(f) for f in item.fields]}
@@ -38,6 +39,10 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
             "fields": fields,
             "bare": m.values_only or None,  # read only right after its request (the last one before it in the capture)
         }
+        if m.layout is not None:  # found by its own code (common/text_frames.py found_by_code: nothing else)
+            after = m.layout.separator if m.layout.after_code is None else m.layout.after_code
+            entry["layout"] = {"after": after, "separator": m.layout.separator, "ending": m.layout.end}
+            alone.append(m)
         messages.setdefault(m.code, {})[m.direction.value] = entry
     for by_direction in messages.values():
         if len(by_direction) == 1:  # the code says the direction (runtime/text.py TextFraming.sentence)
@@ -70,6 +75,7 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         "required": text.required,
         "checksum": checksum,
         "messages": messages,
+        "alone": [{"code": m.code, "direction": m.direction.value} for m in sorted(alone, key=lambda m: -len(m.code))],
     }
     return render(
         "serialspec.backends.wireshark",

@@ -47,10 +47,7 @@ LINES["framing"]["checksum"] = {
     "separated": ["request"],
 }
 LINES["commands"]["dial"]["response"]["values_only"] = True  # ODrive's `r vbus_voltage` answered `24.1`
-# the every-kind case with its own ending (CR LF), for the Wireshark dissector, which refuses FF FF FF
-# (tests/test_wireshark_text.py)
-WIRESHARK = copy.deepcopy(TEXT_CASE) | {"protocol": "wireshark_text_matrix"}
-CASES = {"c_text_matrix": MATRIX, "c_text_lines": LINES, "wireshark_text_matrix": WIRESHARK}
+CASES = {"c_text_matrix": MATRIX, "c_text_lines": LINES}
 SPECS = {
     "nmea0183": ROOT / "specs" / "nmea0183.yaml",
     "textlamp": ROOT / "examples" / "textlamp" / "textlamp.yaml",

@@ -1993,21 +1993,21 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
 
 def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output() -> None:
     """`end: {request: ..., response: ...}` and a response's `text: {code: ...}` of several words (an ELM327's `010C`
-    answered `41 0C 1A F8 ` and CR CR `>`): C and Wireshark refuse each in one line; the reference says both; each
-    direction ends with its own; the reply is found by its own code, the simulator answers with it and the codec
-    pairs it with its request; random messages round trip, all in one stream of both directions read byte by byte;
-    misuse (and of `base`, `case`) refused one line each."""
+    answered `41 0C 1A F8 ` and CR CR `>`): C refuses each in one line (tests/test_wireshark_text.py holds the dissector
+    to decode); the reference says both; each direction ends with its own; the reply is found by its own code, the
+    simulator answers with it and the codec pairs it with its request; random messages round trip, all in one stream of
+    both directions read byte by byte; misuse (and of `base`, `case`) refused one line each."""
 
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["end"] = {"request": "\n", "response": "\n\n>"}
     case["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
-    files = python_and_markdown(case, r"^a line ending of its own for each direction \(`end: \{request: \.\.\.")
+    files = python_and_markdown(case, {"c": r"^a line ending of its own for each direction \(`end: \{request: \.\.\."})
     docs = files["docs/matrix_text.md"]
     assert "| end | LF (requests), LF LF > (responses) |" in docs
     assert "`DialResponse`, a response, under a code of its own (its request's is `DL`)" in docs
     own_code = copy.deepcopy(case)
     own_code["framing"]["end"] = "\n"
-    python_and_markdown(own_code, r"^a reply under a code of its own \(`text: \{code: \.\.\.\}`\)$")
+    python_and_markdown(own_code, {"c": r"^a reply under a code of its own \(`text: \{code: \.\.\.\}`\)$"})
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         asked = package.DialRequest(talker="A", level=7, note="hi")
@@ -2044,25 +2044,21 @@ def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output
 
 
 def test_a_reply_of_values_alone_through_every_output() -> None:
-    """`values_only` on a text response (the dial's): the dissector, which reads each line alone, refuses it in one
-    line (the C reads it as the reply awaited: tests/test_c_text.py holds it to Python, in the case without a
-    start); the reference shows the reply without its code; the package reads it with its request, the simulator
-    answers with it, and a stream of both directions takes it after its request."""
-    from serialspec.backends import Unsupported
+    """`values_only` on a text response (the dial's): every output takes it (the C reads it as the reply awaited, the
+    dissector as the reply to the request right before it: tests/test_c_text.py and tests/test_wireshark_text.py hold
+    them to Python, in the case without a start); the reference shows the reply without its code; the package reads it
+    with its request, the simulator answers with it, and a stream of both directions takes it after its request."""
 
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["dial"]["response"]["values_only"] = True
     protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name == "wireshark":
-            with pytest.raises(Unsupported, match="a reply of values alone"):
-                emitter.files(protocol)
-            continue
         emitted = emitter.files(protocol)
         assert emitter.verify is None or emitter.verify(protocol, emitted) == []
         files.update(emitted)
     assert "its values alone: no code" in files["docs/matrix_text.md"] and "matrix_text/matrix_text.c" in files
+    assert "matrix_text/matrix_text.lua" in files
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         device = importlib.import_module("matrix_text.simulator").SIMULATOR()
@@ -2218,16 +2214,18 @@ def streams_back(package: ModuleType, classes: tuple[Any, ...], direction: str |
 
 
 def python_and_markdown(
-    case: dict[str, Any], refused: str, refusing: tuple[str, ...] = ("c", "wireshark")
+    case: dict[str, Any], refused: str | dict[str, str], refusing: tuple[str, ...] = ("c", "wireshark")
 ) -> dict[str, str]:
-    """A text case's files from every output but those `refusing` it in one line (each verified)."""
+    """A text case's files from every output but those `refusing` it in one line (each verified); `refused`: the
+    line they say, or each one's (the outputs refusing are then its keys)."""
     from serialspec.backends import Unsupported
 
     protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+    said = refused if isinstance(refused, dict) else dict.fromkeys(refusing, refused)
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name in refusing:
-            with pytest.raises(Unsupported, match=refused):
+        if emitter.name in said:
+            with pytest.raises(Unsupported, match=said[emitter.name]):
                 emitter.files(protocol)
             continue
         emitted = emitter.files(protocol)
@@ -2237,15 +2235,15 @@ def python_and_markdown(
 
 
 def test_a_decimal_text_checksum_through_every_output() -> None:
-    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): the dissector refuses it in one line (the C takes it:
-    tests/test_c_text.py holds its C to Python, in the case without a start);
+    """`checksum: {format: decimal}` (G-code's `N1 G28*18`): every output takes it (tests/test_c_text.py holds its C
+    to Python, tests/test_wireshark_text.py its dissector to decode, in the case without a start);
     the reference says how it is written; the package writes the checksum in decimal (no leading zeros), reads it
     back, refuses a wrong one and random messages round trip, byte by byte through the stream parser too."""
     from serialspec.runtime.errors import ChecksumError
 
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"] = {"algorithm": "xor", "format": "decimal", "marker": "!"}
-    files = python_and_markdown(case, r"^a text checksum written in decimal \(`format: decimal`\)$", ("wireshark",))
+    files = python_and_markdown(case, {})
     assert "matrix_text/matrix_text.c" in files  # (the C target, beside the package: matrix_text/*.py)
     assert "`!` + its value in decimal digits (0 to 255)" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
@@ -2320,12 +2318,13 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
 
 
 def test_a_text_checksum_in_one_direction_through_every_output() -> None:
-    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C and
-    Wireshark refuse it in one line; requests carry the checksum, responses none (a marker in one is text), with or
-    without the direction given; random messages round trip, through the stream parser too."""
+    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C refuses it
+    in one line (tests/test_wireshark_text.py holds the dissector to decode); requests carry the checksum, responses
+    none (a marker in one is text), with or without the direction given; random messages round trip, through the stream
+    parser too."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"]["directions"] = ["request"]
-    files = python_and_markdown(case, r"^a text checksum in one direction only \(`checksum.directions`\)$")
+    files = python_and_markdown(case, {"c": r"^a text checksum in one direction only \(`checksum.directions`\)$"})
     assert "; requests only |" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2348,15 +2347,14 @@ def test_a_text_checksum_in_one_direction_through_every_output() -> None:
 
 
 def test_an_optional_text_checksum_after_a_separator_through_every_output() -> None:
-    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): Wireshark refuses it in
-    one line (the C takes it: tests/test_c_text.py holds its C to Python, in the case without a start); requests
+    """`checksum: {required: false, separated: [request]}` (ODrive's `r vbus_voltage *93`): every output takes it
+    (tests/test_c_text.py and tests/test_wireshark_text.py hold C and the dissector to Python, in the case without a
+    start); requests
     write the separator before the marker, covered by the checksum, responses do not; a frame sent without the
     checksum decodes and encodes again without it; random messages round trip."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"].update({"required": False, "separated": ["request"]})
-    files = python_and_markdown(
-        case, r"^a separator before the text checksum \(`checksum.separated`\)$", ("wireshark",)
-    )
+    files = python_and_markdown(case, {})
     assert "matrix_text/matrix_text.c" in files  # (the C target, beside the package: matrix_text/*.py)
     assert "requests write `;` before the marker, covered by it" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
@@ -2377,15 +2375,18 @@ def test_an_optional_text_checksum_after_a_separator_through_every_output() -> N
 
 
 def test_starts_by_direction_and_an_address_before_the_code_through_every_output() -> None:
-    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): C and
-    Wireshark refuse them in one line; the reference shows both starts; the start says the direction; every message
-    carries the address first, its digits before the talker and code; random messages round trip, among each other
-    in a stream of both directions; the simulator answers with the request's address."""
+    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): C refuses the
+    starts in one line (tests/test_wireshark_text.py holds the dissector to decode); the reference shows both starts;
+    the start says the direction; every message carries the address first, its digits before the talker and code; random
+    messages round trip, among each other in a stream of both directions; the simulator answers with the request's
+    address."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["start"] = {"request": "#", "response": "$"}
     case["framing"]["address"] = "unit"
     case["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
-    files = python_and_markdown(case, r"^a start of its own for each direction \(`start: \{request: \.\.\., response")
+    files = python_and_markdown(
+        case, {"c": r"^a start of its own for each direction \(`start: \{request: \.\.\., response"}
+    )
     assert "| start | `#` or `$` | starts a request or a response |" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2465,8 +2466,9 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
 
 def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
     """A `text` field's `size: rest` (Marlin's `Error:checksum mismatch, Last Line: 122`): the rest of the line,
-    separators included, in a plain message and in one found by its code; C and Wireshark refuse it in one line; the
-    reference says so; round trips, with separators and the layout's own characters in the text; misplaced, refused."""
+    separators included, in a plain message and in one found by its code; C refuses it in one line
+    (tests/test_wireshark_text.py holds the dissector to decode); the reference says so; round trips, with separators
+    and the layout's own characters in the text; misplaced, refused."""
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["note"] = {
         "code": "NT",
@@ -2480,7 +2482,7 @@ def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
             "fields": {"msg": {"type": "text", "size": "rest"}},
         },
     }
-    files = python_and_markdown(case, r"^a text field to the end of the line \(`size: rest`\)$")
+    files = python_and_markdown(case, {"c": r"^a text field to the end of the line \(`size: rest`\)$"})
     assert "text (the rest of the line, separators included)" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

@@ -5,16 +5,22 @@ fields as the texts `runtime/text.py` decodes (what `serialspec decode --json` p
 
 from __future__ import annotations
 
+import copy
+import importlib
 import shutil
 import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
-from test_c_text import CLI, NAMES, SPECS, built, python_json
+from serialspec.runtime.text import TextField
+from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
+from test_language_matrix import TEXT_CASE
 from test_text_frames import sentence_values
 
 pytestmark = pytest.mark.slow
@@ -57,8 +63,8 @@ def flat(fields: dict[str, Any]) -> list[tuple[str, str]]:
     return out
 
 
-# the C's text specs, the every-kind case with the ending the dissector takes (the C's ends in FF FF FF)
-DISSECTED = [name if name != "c_text_matrix" else "wireshark_text_matrix" for name in NAMES]
+# the C's text specs (the every-kind case's line ending is FF FF FF)
+DISSECTED = NAMES
 
 
 @pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
@@ -102,5 +108,86 @@ def test_tshark_shows_random_sentences_as_decode_does(name: str, tmp_path: Path)
             assert got["fields"] == flat(expected["fields"]), (got, expected)
             if b.framing.checksum is not None:
                 assert (got["checksum_ok"] in ("1", "True")) == expected["checksum_ok"], got
+
+    shown_as_decoded()
+
+
+# What the C target does not take but the dissector does, each beside the others: every line a frame (no start
+# character, CR LF, an optional XOR checksum in decimal after a separator in requests, a reply of values alone
+# read after its request: the C's lines case), and a start, line ending and checksum of each direction's own (LSS's
+# `#` and `*` with the servo id before the code, a reply ended by bytes above 0x7F as Nextion's under a code of its
+# own, a checksum in requests alone; a text to the end of the line).
+ONE_WAY = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_one_way"}
+ONE_WAY["framing"]["start"] = {"request": "#", "response": "*"}
+ONE_WAY["framing"]["end"] = {"request": "\n", "response": "\r\xff\xff\xff"}
+ONE_WAY["framing"]["checksum"]["directions"] = ["request"]
+ONE_WAY["framing"]["address"] = "unit"  # LSS's servo id: `#5QD` asked, `*5QD1800` answered
+ONE_WAY["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
+ONE_WAY["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}  # a reply under a code of its own
+ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators and all
+    "code": "NT",
+    "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+}
+BY_DIRECTION = {"ws_text_lines": copy.deepcopy(LINES) | {"protocol": "ws_text_lines"}, "ws_text_one_way": ONE_WAY}
+
+
+@pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
+@pytest.mark.parametrize("name", list(BY_DIRECTION))
+def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: str, tmp_path: Path) -> None:
+    """Each message after the request it answers (a reply of values alone is read as that request's reply, as
+    decode reads it given the request); the last one cut across two packets; a request with a bad checksum after
+    them. tshark shows each as decode does, the checksum checked where the direction carries one."""
+    assert TSHARK is not None
+    spec = tmp_path / f"{name}.yaml"
+    spec.write_text(yaml.safe_dump(BY_DIRECTION[name], sort_keys=False), encoding="utf-8")
+    for target in ("python", "wireshark"):
+        run(*CLI, "generate", str(spec), "--target", target, "--out", str(tmp_path))
+    sys.path.insert(0, str(tmp_path))
+    try:
+        package = importlib.import_module(name)
+    finally:
+        sys.path.remove(str(tmp_path))
+    b = Built(name, tmp_path, package, package.FRAMING)
+    framing = b.framing
+    script = f"lua_script:{tmp_path / name / f'{name}.lua'}"
+    talkers = framing.talkers or ("X" * framing.talker,)
+
+    @settings(max_examples=2, deadline=None, suppress_health_check=list(HealthCheck), phases=(Phase.generate,))
+    @given(st.data())
+    def shown_as_decoded(data: st.DataObject) -> None:
+        frames, wanted, asked = [], [], None
+        for s in framing.sentences:
+            values = data.draw(sentence_values(s))
+            for item in s.fields:  # a text to the end of the line holds separators
+                if isinstance(item, TextField) and item.rest:
+                    values[item.name] = f"a{framing.separator}b {framing.separator}{values[item.name] or ''}"
+            talker = data.draw(st.sampled_from(talkers))
+            frame = framing.encode(s.code, values, talker, direction=s.direction)
+            frames.append((s.direction, frame))
+            decoded = framing.decode(frame, s.direction, asked if s.direction == "response" else None)
+            wanted.append(python_json(b, decoded) | {"checksum_ok": True})
+            asked = s.code if s.direction == "request" else None
+        direction, last = frames[-1]
+        packets = [*frames[:-1], (direction, last[:3]), (direction, last[3:])]  # the last one cut across two packets
+        first_direction, first = frames[0]
+        assert first_direction == "request"
+        if framing.checksum is not None:  # a request with a bad checksum
+            marker = first.rfind(framing.marker.encode())
+            packets.append((first_direction, first[: marker + 1] + b"ZZ" + first[marker + 3 :]))
+            wanted.append(wanted[0] | {"checksum_ok": False})
+        lines = [f"# serialspec capture: {name}"]
+        lines += [f"2026-11-25T10:00:00.000000+00:00 {d} {f.hex(' ')}" for d, f in packets]
+        (tmp_path / "t.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        run(*CLI, "export", str(tmp_path / "t.capture"), "--pcap", str(tmp_path / "t.pcap"))
+        seen = sentences(run(TSHARK, "-X", script, "-r", str(tmp_path / "t.pcap"), "-T", "pdml"), name)
+        assert len(seen) == len(wanted), seen
+        for got, expected in zip(seen, wanted, strict=True):
+            assert got["command"] == expected["command"] and got["direction"] == expected["direction"], got
+            assert got.get("talker", "") == expected["talker"]
+            assert got["fields"] == flat(expected["fields"]), (got, expected)
+            if expected["direction"] in framing.checksummed and framing.checksum is not None:
+                assert (got["checksum_ok"] in ("1", "True")) == expected["checksum_ok"], got
+            else:
+                assert "checksum_ok" not in got, got
 
     shown_as_decoded()

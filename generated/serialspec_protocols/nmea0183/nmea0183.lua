@@ -16,14 +16,19 @@ local SPEC = {
   separator = ",",
   marker = "*",
   ending = "\x0d\x0a",
+  decimal = false,
+  checksummed = {request = true, response = true},
+  separated = {},
   digits = 2,
   talker = 2,
+  address = false,
   required = false,
   checksum = {algorithm = "xor", invert = false, little = false},
   messages = {
     GGA = {
       response = {
         command = "gga",
+        code = "GGA",
         direction = "response",
         title = "Global Positioning System Fix Data",
         fields = {
@@ -48,6 +53,7 @@ local SPEC = {
     RMC = {
       response = {
         command = "rmc",
+        code = "RMC",
         direction = "response",
         title = "Recommended Minimum Specific GNSS Data",
         fields = {
@@ -70,6 +76,7 @@ local SPEC = {
     VTG = {
       response = {
         command = "vtg",
+        code = "VTG",
         direction = "response",
         title = "Track Made Good and Ground Speed",
         fields = {
@@ -89,6 +96,7 @@ local SPEC = {
     GSA = {
       response = {
         command = "gsa",
+        code = "GSA",
         direction = "response",
         title = "GNSS DOP and Active Satellites",
         fields = {
@@ -105,6 +113,7 @@ local SPEC = {
     GSV = {
       response = {
         command = "gsv",
+        code = "GSV",
         direction = "response",
         title = "GNSS Satellites in View",
         fields = {
@@ -127,6 +136,7 @@ local SPEC = {
       only = "response",
     },
   },
+  alone = {},
 }
 
 -- bit operations (Lua 5.2's bit32, or 5.3's operators) and the mask of a width, for the checksums' Lua code
@@ -203,10 +213,11 @@ CHECKSUMS["xor"] = function(spec, size, data)
 end
 
 -- the fields of a sentence's body after the address: {start, text} each (start: offset in the packet, 0-based)
-local function split(data, first, last)
+local function split(data, first, last, separator)
+  separator = separator or SPEC.separator
   local parts, at = {}, first
   while true do
-    local stop = data:find(SPEC.separator, at, true)
+    local stop = data:find(separator, at, true)
     if stop == nil or stop > last then
       parts[#parts + 1] = {at, data:sub(at, last)}
       return parts
@@ -214,6 +225,26 @@ local function split(data, first, last)
     parts[#parts + 1] = {at, data:sub(at, stop - 1)}
     at = stop + 1
   end
+end
+
+-- the message found by its own code at data[first..last] (the talker left out: an ELM327's `41 0C`, the longest
+-- code that fits, then its `after_code` and its own ending), its fields' parts and where they end; nil: none fits
+local function found_alone(data, first, last, direction)
+  local text = data:sub(first, last)
+  for _, item in ipairs(SPEC.alone) do
+    if item.direction == direction and text:sub(1, #item.code) == item.code then
+      local message = SPEC.messages[item.code][direction]
+      local layout, rest = message.layout, text:sub(#item.code + 1)
+      if rest == "" then return message, {}, last end
+      if rest:sub(1, #layout.after) == layout.after
+        and (layout.ending == "" or rest:sub(-#layout.ending) == layout.ending) then
+        local inner_first, inner_last = first + #item.code + #layout.after, last - #layout.ending
+        if inner_last < inner_first then return message, {}, inner_last end
+        return message, split(data, inner_first, inner_last, layout.separator), inner_last
+      end
+    end
+  end
+  return nil
 end
 
 local function add_field(tree, tvb, pf, part)
@@ -224,47 +255,88 @@ local function add_field(tree, tvb, pf, part)
   end
 end
 
--- one sentence at data[first..last] (the line ending left out)
-local function dissect_sentence(tvb, data, first, last, size, tree, direction_code, info)
+-- the text a direction's sentences start with and end with (each direction its own where the spec gives two)
+local function start_of(direction)
+  return direction == "response" and SPEC.response_start or SPEC.start
+end
+local function ending_of(direction)
+  return direction == "response" and SPEC.response_ending or SPEC.ending
+end
+
+-- the checksum written after the marker, checked against the text it covers: true, false, or nil (no checksum)
+local function verify(written, covered)
+  local value = CHECKSUMS[SPEC.checksum.algorithm](SPEC.checksum, math.floor(SPEC.digits / 2), covered)
+  if SPEC.decimal then -- decimal digits, 1 to 3 (G-code's `*71`)
+    return #written >= 1 and #written <= 3 and written:match("^%d+$") ~= nil and tonumber(written) == value
+  end
+  return #written == SPEC.digits and written:match("^%x+$") ~= nil and tonumber(written, 16) == value
+end
+
+-- one sentence at data[first..last] (its start at first, the line ending left out); `asked`: the code of the request
+-- before it in the capture (a reply of values alone is read as that request's reply)
+local function dissect_sentence(tvb, data, first, last, size, tree, direction, info, asked)
   local root = tree:add(proto, tvb(first - 1, size))
-  local stop, checked = last, nil
-  if SPEC.checksum then
+  local body, stop, checked = first + #start_of(direction), last, nil
+  if SPEC.checksum and SPEC.checksummed[direction] then
     local marker = nil
-    for i = last, first + 1, -1 do
-      if data:sub(i, i) == SPEC.marker then marker = i break end
+    for i = last - #SPEC.marker + 1, body, -1 do
+      if data:sub(i, i + #SPEC.marker - 1) == SPEC.marker then marker = i break end
     end
     if marker then
-      local written = data:sub(marker + 1, last)
-      root:add(f_checksum, tvb(marker, last - marker), written)
-      local covered = data:sub(first + 1, marker - 1)
-      local value = CHECKSUMS[SPEC.checksum.algorithm](SPEC.checksum, math.floor(SPEC.digits / 2), covered)
-      checked = #written == SPEC.digits and tonumber(written, 16) == value
-      local item = root:add(f_checksum_ok, tvb(marker, last - marker), checked)
+      local after = marker + #SPEC.marker
+      local written = data:sub(after, last)
+      root:add(f_checksum, tvb(after - 1, last - after + 1), written)
+      checked = verify(written, data:sub(body, marker - 1))
+      local item = root:add(f_checksum_ok, tvb(after - 1, last - after + 1), checked)
       if not checked then item:add_proto_expert_info(e_checksum) end
       stop = marker - 1
+      if SPEC.separated[direction] and data:sub(stop - #SPEC.separator + 1, stop) == SPEC.separator then
+        stop = stop - #SPEC.separator -- ODrive's `r vbus_voltage *93`: the separator before the marker
+      end
     elseif SPEC.required then
       root:add_proto_expert_info(e_malformed, "no checksum")
     end
   end
-  local parts = split(data, first + 1, stop)
+  local address_part = nil -- the framing's address: its digits, right after the start
+  if SPEC.address then
+    local digits = body
+    while digits <= stop and data:byte(digits) >= 48 and data:byte(digits) <= 57 do digits = digits + 1 end
+    address_part, body = {body, data:sub(body, digits - 1)}, digits
+  end
+  local parts = split(data, body, stop)
   local address = parts[1][2]
   local talker, code = address:sub(1, SPEC.talker), address:sub(SPEC.talker + 1)
-  if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, #talker), talker) end
-  root:add(f_code, tvb(parts[1][1] - 1 + #talker, #code), code)
   local by_direction = SPEC.messages[code]
-  if by_direction == nil then
+  local message = by_direction and by_direction[by_direction.only or direction]
+  local bare = asked and SPEC.messages[asked] and SPEC.messages[asked].response
+  local coded = by_direction and by_direction[direction] and not by_direction[direction].bare
+  local plain = coded and not by_direction[direction].layout -- a code of the framing's own text
+  local head, head_size = parts[1][1], #address -- talker and code, shown under the command's name
+  local at, own, own_parts, own_last = 2, nil, nil, nil
+  if #SPEC.alone > 0 and not plain then
+    own, own_parts, own_last = found_alone(data, body + SPEC.talker, stop, direction)
+  end
+  if own then -- found by its own code: its fields after it
+    local at_code = parts[1][1] + SPEC.talker
+    if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, SPEC.talker), talker) end
+    root:add(f_code, tvb(at_code - 1, #own.code), own.code)
+    message, parts, stop, at, head_size = own, own_parts, own_last, 1, SPEC.talker + #own.code
+  elseif direction == "response" and bare and bare.bare and not coded then
+    message, at = bare, 1 -- a reply of values alone, right after its request: every part a field
+  elseif message == nil then
+    root:add(f_code, tvb(parts[1][1] - 1, #address), code)
     root:add_proto_expert_info(e_malformed, "unknown text code " .. code)
     info[#info + 1] = "unknown " .. code
-    return
+    return nil
+  else
+    if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, #talker), talker) end
+    root:add(f_code, tvb(parts[1][1] - 1 + #talker, #code), code)
   end
-  local direction = by_direction.only or DIRECTIONS[direction_code] or "response"
-  local message = by_direction[direction] or by_direction.response or by_direction.request
-  root:add(f_command, tvb(parts[1][1] - 1, #address), message.command)
-  root:add(f_direction, tvb(parts[1][1] - 1, #address), message.direction)
+  root:add(f_command, tvb(head - 1, head_size), message.command)
+  root:add(f_direction, tvb(head - 1, head_size), message.direction)
   root:set_text(string.format("%s %s %s%s", SPEC.title, message.direction, message.title,
     checked == false and " [bad checksum]" or ""))
   info[#info + 1] = message.command
-  local at = 2
   for _, item in ipairs(message.fields) do
     if item.fields then
       local groups = item.count
@@ -277,18 +349,39 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction_co
           at = at + 1
         end
       end
+    elseif item.address then -- read before the code
+      add_field(root, tvb, item.pf, address_part)
+    elseif item.rest then -- the rest of the line, separators included
+      local part = parts[at] and {parts[at][1], data:sub(parts[at][1], stop)} or nil
+      add_field(root, tvb, item.pf, part)
+      at = math.max(at + 1, #parts + 1)
     else
       add_field(root, tvb, item.pf, parts[at])
       at = at + 1
     end
   end
   if at <= #parts then root:add_proto_expert_info(e_malformed, "more fields than the message has") end
+  return message
 end
 
--- bytes of the sentence at the end of a packet go before the next packet of the same direction
-local carried, pending = {}, {}
+-- bytes of the sentence at the end of a packet go before the next packet of the same direction; the code of the
+-- request read last before each packet (nil after a reply), kept on the first pass (Wireshark dissects packets
+-- again, in any order): a reply of values alone right after it is read as its reply
+local carried, pending, asked, last_request = {}, {}, {}, nil
 function proto.init()
-  carried, pending = {}, {}
+  carried, pending, asked, last_request = {}, {}, {}, nil
+end
+
+-- the sentence at data[first..stop - 1] (its line ending after it): the message read, or nil
+local function sentence_at(tvb, data, first, stop, tree, direction, info, request)
+  local size = stop + #ending_of(direction) - first
+  local done, message = pcall(dissect_sentence, tvb, data, first, stop - 1, size, tree, direction, info, request)
+  if not done then
+    local item = tree:add(proto, tvb(first - 1, size))
+    item:add_proto_expert_info(e_malformed, tostring(message))
+    return nil
+  end
+  return message
 end
 
 local function dissect(tvb, pinfo, tree, direction_code)
@@ -296,40 +389,46 @@ local function dissect(tvb, pinfo, tree, direction_code)
   if not pinfo.visited then
     carried[pinfo.number] = pending[direction_code]
     pending[direction_code] = nil
+    asked[pinfo.number] = last_request
   end
+  local request = asked[pinfo.number]
   local data = tvb:raw()
   if carried[pinfo.number] then
     data = carried[pinfo.number] .. data
     tvb = ByteArray.new(data, true):tvb("Sentences completed by this packet")
   end
+  local direction = DIRECTIONS[direction_code] or "response"
+  local start, ending = start_of(direction), ending_of(direction)
   local pos, info = 1, {}
   while pos <= #data do
-    local first = data:find(SPEC.start, pos, true)
+    local first = start == "" and pos or data:find(start, pos, true) -- without a start, every line is a sentence
     if first == nil then
       tree:add(f_garbage, tvb(pos - 1))
       break
     end
     if first > pos then tree:add(f_garbage, tvb(pos - 1, first - pos)) end
-    local ending = data:find(SPEC.ending, first + 1, true)
-    local restart = data:find(SPEC.start, first + 1, true)
-    if restart and (ending == nil or restart < ending) then
+    local stop = data:find(ending, first + #start, true)
+    local restart = start ~= "" and data:find(start, first + 1, true)
+    if restart and (stop == nil or restart < stop) then
       tree:add(f_garbage, tvb(first - 1, restart - first)):add_proto_expert_info(e_malformed, "cut short")
       pos = restart
-    elseif ending == nil then
+    elseif stop == nil then
       tree:add(f_incomplete, tvb(first - 1))
       info[#info + 1] = "sentence continues"
       if not pinfo.visited and #data - first < 65536 then pending[direction_code] = data:sub(first) end
       break
     else
-      local size = ending + #SPEC.ending - first
-      local done, problem = pcall(dissect_sentence, tvb, data, first, ending - 1, size, tree, direction_code, info)
-      if not done then
-        local item = tree:add(proto, tvb(first - 1, size))
-        item:add_proto_expert_info(e_malformed, tostring(problem))
+      if start == "" then -- a line: CR or LF before it is the rest of a longer line ending; a blank one is none
+        while first < stop and (data:byte(first) == 13 or data:byte(first) == 10) do first = first + 1 end
       end
-      pos = ending + #SPEC.ending
+      if start ~= "" or not data:sub(first, stop - 1):match("^%s*$") then
+        local message = sentence_at(tvb, data, first, stop, tree, direction, info, request)
+        request = message and message.direction == "request" and message.code or nil
+      end
+      pos = stop + #ending
     end
   end
+  if not pinfo.visited then last_request = request end
   pinfo.cols.info = table.concat(info, ", ")
 end
 

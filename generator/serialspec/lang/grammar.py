@@ -542,7 +542,7 @@ _FIELD_LONG: dict[str, Shape] = {
         "earlier integer fields, which stay in the message (`length - 2`: see `count`); array: the earlier "
         "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
         "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
-        "mismatch, Last Line: 122` as one text); the C target and the Wireshark dissector refuse it, saying so.",
+        "mismatch, Last Line: 122` as one text); the C target refuses it, saying so.",
     ),
     "count": OneOf(
         (Int(), Str()),
@@ -724,8 +724,7 @@ TEXT_LAYOUT = Obj(
             'own (an ELM327 answers `010C` with `41 0C 1A F8`: `response: {text: {code: "41 0C"}}`; an AT modem '
             'answers `AT+CSQ` with `+CSQ: 20,99`: `text: {code: "+CSQ:", after_code: " "}`). It may hold '
             "the message's separator (several words); the message is found by it, the longest code that fits, and "
-            "clients and the simulator pair it with its request as usual. The C target and the Wireshark dissector "
-            "refuse it, saying so.",
+            "clients and the simulator pair it with its request as usual. The C target refuses it, saying so.",
             example="41 0C",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
@@ -782,8 +781,8 @@ MESSAGE = Obj(
             "answer `MEAS:VOLT?` with `+1.234E+00`). It is read "
             "as the reply to the request before it: `decode` refuses it without that request (`--request`), the "
             "stream parser takes it while the request awaits its reply (the client's, or the request just read in a "
-            "stream of both directions), and the simulator answers with it. The C target and the dissector, which "
-            "read each line alone, refuse such a spec.",
+            "stream of both directions), and the simulator answers with it. The C decoder reads it as the reply "
+            "awaited; the Wireshark dissector as the reply to the request right before it in the capture.",
             default=False,
             example=True,
         ),
@@ -1518,8 +1517,8 @@ FRAMING = Obj(
             "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
             "line ending) and the stream parser resynchronises at the next line ending. A mapping gives each "
             'direction its own (Lynxmotion LSS: `start: {request: "#", response: "*"}`, `#5QD` asked and '
-            "`*5QD1800` answered): a frame's start then says its direction. The C target and the Wireshark "
-            "dissector refuse starts that differ by direction, saying so.",
+            "`*5QD1800` answered): a frame's start then says its direction. The C target refuses starts that "
+            "differ by direction, saying so.",
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),
@@ -1537,8 +1536,8 @@ FRAMING = Obj(
             "text: the line ending that closes every frame. A mapping gives each direction its own (an ELM327 "
             'OBD-II adapter: `end: {request: "\\r", response: "\\r\\r>"}`, its reply ended by CR, a blank line '
             "and its `>` prompt): the stream parser of one direction waits for that direction's, and one reading "
-            "both takes the longest that ends a frame. The C target and the Wireshark dissector refuse line endings "
-            "that differ by direction, saying so.",
+            "both takes the longest that ends a frame. The C target refuses line endings that differ by direction, "
+            "saying so.",
             example="\r\n",
         ),
         "checksum": Obj(
@@ -1553,8 +1552,7 @@ FRAMING = Obj(
                 "format": Str(
                     "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum, NMEA 0183); "
                     "decimal, its value in decimal digits without leading zeros, 0 to 255 (G-code's line checksum, "
-                    "Marlin and RepRap firmware: `N1 G28*18`; ODrive's ASCII protocol). The C target and the "
-                    "Wireshark dissector refuse a decimal one, saying so.",
+                    "Marlin and RepRap firmware: `N1 G28*18`; ODrive's ASCII protocol).",
                     choices=("hex2", "decimal"),
                     default="hex2",
                     example="decimal",
@@ -1570,16 +1568,15 @@ FRAMING = Obj(
                     Str(choices=("request", "response")),
                     "The directions whose frames write the separator between the last field and the marker, "
                     "covered by the checksum (ODrive's documented request `r vbus_voltage *93`; its replies, "
-                    "`12.5*48`, do not: `separated: [request]`); decode also takes such a frame without it. The C "
-                    "target and the Wireshark dissector refuse it, saying so.",
+                    "`12.5*48`, do not: `separated: [request]`); decode also takes such a frame without it.",
                     example=["request"],
                 ),
                 "directions": ListOf(
                     Str(choices=("request", "response")),
                     "The directions whose frames carry it (default both): G-code's numbered lines carry one, the "
                     "firmware's `ok` and `Resend: 124` none (`directions: [request]`); a frame of the other "
-                    "direction is text to its end, the marker too. The C target and the Wireshark dissector refuse "
-                    "a checksum in one direction only, saying so.",
+                    "direction is text to its end, the marker too. The C target refuses a checksum in one direction "
+                    "only, saying so.",
                     example=["request"],
                 ),
             },
@@ -1605,8 +1602,7 @@ FRAMING = Obj(
             "text: a shared integer field (its name in `fields:`) that every message carries first, its digits "
             "written right after the start and before the talker and code, with nothing between (Lynxmotion LSS's "
             "servo id: `address: id` reads `#5D1800` as id 5, code D, 1800). Messages, JSON and client methods have "
-            "it as a field; the simulator answers with the request's. The C target and the Wireshark dissector "
-            "refuse it, saying so.",
+            "it as a field; the simulator answers with the request's. The C target refuses it, saying so.",
             example="id",
         ),
         "max_length": Int(
@@ -1652,8 +1648,8 @@ FRAMING = Obj(
             "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
             "zero-padded to `width` digits, "
             "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
-            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it and the "
-            "Wireshark dissector refuse line endings by direction and reply codes of their own, one line each.",
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it refuses line "
+            "endings by direction and reply codes of their own, one line each.",
         ),
     ),
 )

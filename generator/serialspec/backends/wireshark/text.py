@@ -9,18 +9,21 @@ from typing import Any
 from serialspec.backends import Unsupported
 from serialspec.backends.common.render import render
 from serialspec.backends.common.text import collapse
-from serialspec.backends.common.text_frames import refuse_text_frames
+from serialspec.backends.common.text_frames import WIRESHARK_TAKES, refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
-from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
 
 
 def _field(f: TextField) -> dict[str, Any]:
-    return {"name": f.name, "title": f.name}
+    # `rest`: the rest of the line, separators included (the message's last field)
+    # `address`: the framing's, every message's first field, its digits right after the start (LSS's servo id)
+    return {"name": f.name, "title": f.name, "rest": f.rest or None, "address": f.address or None}
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
-    refuse_text_frames(text)
+    refuse_text_frames(text, WIRESHARK_TAKES)
     messages: dict[str, dict[str, Any]] = {}
+    alone: list[TextMessage] = []  # the messages found by their own code, the longest code first
     for m in text.messages:
         fields = [
             {"name": item.name, "count": item.count, "max": item.max_count, "fields": [_field(f) for f in item.fields]}
@@ -28,7 +31,18 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
             else _field(item)
             for item in m.fields
         ]
-        entry = {"command": m.key, "direction": m.direction.value, "title": m.title, "fields": fields}
+        entry: dict[str, Any] = {
+            "command": m.key,
+            "code": m.code,
+            "direction": m.direction.value,
+            "title": m.title,
+            "fields": fields,
+            "bare": m.values_only or None,  # read only right after its request (the last one before it in the capture)
+        }
+        if m.layout is not None:  # found by its own code (common/text_frames.py found_by_code: nothing else)
+            after = m.layout.separator if m.layout.after_code is None else m.layout.after_code
+            entry["layout"] = {"after": after, "separator": m.layout.separator, "ending": m.layout.end}
+            alone.append(m)
         messages.setdefault(m.code, {})[m.direction.value] = entry
     for by_direction in messages.values():
         if len(by_direction) == 1:  # the code says the direction (runtime/text.py TextFraming.sentence)
@@ -44,15 +58,24 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
     data = {
         "name": protocol.name,
         "title": protocol.title,
-        "start": text.start,
+        # the framing's own text as bytes (a line ending may hold bytes above 0x7F: Nextion's FF FF FF); each
+        # direction's own where it has one (nil: the requests')
+        "start": text.start.encode("latin-1"),
+        "response_start": text.response_start.encode("latin-1") or None,
         "separator": text.separator,
         "marker": text.marker,
-        "ending": text.end,
+        "ending": text.end.encode("latin-1"),
+        "response_ending": text.response_end.encode("latin-1") or None,
+        "decimal": text.checksum_format == "decimal",
+        "checksummed": {d: True for d in text.checksum_directions},
+        "separated": {d: True for d in text.checksum_separated},
         "digits": text.digits,
         "talker": text.talker,
+        "address": text.address is not None,
         "required": text.required,
         "checksum": checksum,
         "messages": messages,
+        "alone": [{"code": m.code, "direction": m.direction.value} for m in sorted(alone, key=lambda m: -len(m.code))],
     }
     return render(
         "serialspec.backends.wireshark",

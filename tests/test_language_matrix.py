@@ -921,6 +921,29 @@ CASES["frame: reply_code, frame engine"] = Case(
     },
     commands=REPLY_CODED,
 )
+# A request code wider than the replies' command element (VISCA: 01 04 asked, 50 answered): the reply code's
+# expression takes the request's u16 code, and a reply-only command's code fits the reply element
+CASES["frame: reply_code, u16 request codes and u8 reply codes"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "code": {"role": "command", "type": "u16", "endian": "big", "directions": ["request"]},
+            "reply": {
+                "role": "command",
+                "type": "u8",
+                "directions": ["response"],
+                "reply_code": "(code + (code >> 8)) & 0xFF",
+            },
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+    commands={**REPLY_CODED, "other": {**REPLY_CODED["other"], "code": 0x0902}},
+)
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads
 SHARED_CODE = {

@@ -1271,7 +1271,10 @@ FRAME_ELEMENT = Obj(
             "alternative layouts, every layout's command element gives the same one, unless layouts are chosen by "
             "command (`layout:`): then only the commands whose replies travel in a layout that gives it have a reply "
             "code (HLK-LD2410: ACKs under `code | 0x0100` in the command layout, beside reports whose type byte is "
-            "their own code in a report layout without it).",
+            "their own code in a report layout without it). Where requests and replies have command elements of "
+            "their own (`directions:`), it goes on either, and `code` is the request's, which may be wider than "
+            'the reply\'s (a u16 request code, a u8 reply code: `reply_code: "code & 0xFF"`); without it, a code '
+            "that does not fit the replies' command element is refused in one line.",
             example="code | 0x40",
         ),
         "code": Str(

@@ -72,6 +72,11 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
     ("change", "expected"),
     [
         (("title: Move", "title: Move\n    colour: red"), "unknown key 'colour'"),
+        # a key of the mapping one level lower: says where it goes (a response's `answers` written on its command)
+        (
+            ("title: Move", "title: Move\n    answers: move"),
+            "unknown key 'answers' (a key of `request:` or `response:`, one level lower; expected one of code,",
+        ),
         (("angle: i16", "angle: i16\n        angle: u8"), "duplicate key 'angle'"),
         (("angle: i16", "self: i16"), "reserved"),
         (("angle: i16", "from_: i16"), "is the Python name of a field 'from': call it 'from'"),

@@ -208,6 +208,15 @@ class MapOf(Shape):
         }
 
 
+def _mapping_keys(shape: Shape) -> Iterable[str]:
+    """The keys of the mapping a key's value is (a Ref's target's; each mapping a OneOf takes), else none."""
+    if isinstance(shape, Ref):
+        shape = shape.target()
+    if isinstance(shape, OneOf):
+        return [key for option in shape.options for key in _mapping_keys(option)]
+    return shape.keys if isinstance(shape, Obj) else ()
+
+
 def _did_you_mean(key: object, keys: Iterable[str]) -> str:
     """ "did you mean 'range'? " for a key one or two letters from one of `keys` (`rnage`), else ""."""
     if not isinstance(key, str):
@@ -251,13 +260,24 @@ class Obj(Shape):
                 # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
                 cut = isinstance(key, str) and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", key)
                 hint = "; a comma inside `{...}` ends a value: quote text that holds one" if cut else ""
+                close = _did_you_mean(key, self.keys)
+                lower = "" if close or cut else self._lower_homes(key)
                 yield (
                     (*path, key),
-                    f"unknown key {key!r} ({_did_you_mean(key, self.keys)}expected one of "
-                    + (f"{', '.join(self.keys)}{hint})"),
+                    f"unknown key {key!r} ({close}{lower}expected one of " + (f"{', '.join(self.keys)}{hint})"),
                 )
             else:
                 yield from shape.check(item, (*path, key))
+
+    def _lower_homes(self, key: Any) -> str:
+        """ "a key of `response:`, one level lower; " for a key of the mapping one of this mapping's keys holds
+        (a command's `answers`, a key of its request or response), else ""."""
+        if not isinstance(key, str):
+            return ""
+        homes = [name for name, shape in self.keys.items() if key in _mapping_keys(shape)]
+        if not homes:
+            return ""
+        return f"a key of {' or '.join(f'`{name}:`' for name in homes)}, one level lower; "
 
     def _strays(self, value: dict[Any, Any], missing: list[str]) -> tuple[str, list[Any]]:
         """(the key, the unknown keys of `value`) when those are all entries of the one mapping key they fit, absent

@@ -1012,6 +1012,13 @@ CASES["replies sharing a code, by content size, frame engine"] = Case(
     CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
     commands=SHARED_REPLIES,
 )
+# ... and in a frame ended by its terminator, without a length (VISCA's inquiry replies, 90 50 ... FF)
+CASES["replies sharing a code, by content size, ended by a terminator"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "x": "u32"},
+    CASES["frame: ended by a terminator, no length"].framing,
+    commands=SHARED_REPLIES,
+)
 # Messages picked by their leading constant (lang/model/discriminator.py), before sizes that overlap: RTCM 3's frame
 # without a command element, each request's content beginning with its 12-bit message number (`descriptor`'s
 # counted string makes 4 bytes or more, probe's 5); and requests that share a code, picked by a leading u8

@@ -624,7 +624,10 @@ class Commands(FieldResolver):
                         # size (iRobot's sensor queries): no length needed
                         continue
                     kind = direction.value
-                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                    if any(
+                        alt.length is None and not alt.trailer and alt.transparency is None
+                        for alt in framing.alternatives.get(direction, (layout,))
+                    ):
                         shared = (
                             f"{what} in {kind} frames is already used by {users[0][0].name!r}; {kind}s that share "
                             "a code"
@@ -641,7 +644,8 @@ class Commands(FieldResolver):
                         reason = why_not_picked(alike)
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{shared} are told apart by their content size, which needs a length element{reason}"
+                            f"{shared} are told apart by their content size, which needs a length element, a trailer "
+                            f"or a transform{reason}"
                             f"{other}",
                         )
                     elif discriminator([m for _, m in users]) is None:

@@ -414,3 +414,23 @@ def test_a_spec_the_c_target_cannot_generate_is_refused_in_one_line_naming_the_f
     assert everything.stderr.splitlines() == [
         "lamp.yaml: no c output: the request frame: element length of type i8 (the other outputs are written)"
     ]
+
+
+def test_sim_without_id_names_the_default_id_not_an_id_typed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`serialspec sim visca.yaml` (an address range 0x81..0x88, no `device.ids`) said "--id 0 is outside the spec's
+    id range" of an --id nobody typed (found writing Sony VISCA as a new user)."""
+    spec = tmp_path / "cam.yaml"
+    spec.write_text(
+        "protocol: cam\ntitle: Cam\nbyte_order: little\nserial: {baudrate: 9600}\nframing:\n  elements:\n"
+        "    camera: {role: address, type: u8, range: [0x81, 0x88], broadcast: 0x88}\n"
+        "    code: {role: command, type: u8}\n    content: {role: content}\n    end: {role: trailer, value: FF}\n"
+        "commands:\n  home: {code: 4, request: {fields: {}}, response: {fields: {}}}\ndevice: {}\n",
+        encoding="utf-8",
+    )
+    assert main(["sim", str(spec)]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec sim: no --id given, and the spec's default id 0 (`device.ids`: 0 when not given) is outside its "
+        "id range 129..136: give --id N, or `ids: [N]` under `device:`"
+    )

@@ -1825,9 +1825,11 @@ DEVICE_COMMAND = Obj(
             description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
         ),
         "reports": MapOf(
-            Str(),
+            OneOf((Int(), Str())),
             "Response field -> the state variable or memory entry it reports, or an expression of them where the "
-            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`).",
+            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`), or a number (a MediaTek "
+            "PMTK001 acknowledging command 220: `{command: 220, flag: 3}`; in a text `char` field a number is "
+            "written as its digit, the flag's letter `3`).",
         ),
         "moves": Obj(
             {
@@ -2211,9 +2213,9 @@ DEVICE = Obj(
                         example="fix",
                     ),
                     "values": MapOf(
-                        Str(),
-                        "Field -> an expression of state variables and memory entries it holds (other fields: the "
-                        "device's `reply` values, else 0).",
+                        OneOf((Int(), Str())),
+                        "Field -> an expression of state variables and memory entries it holds, or a number (other "
+                        "fields: the device's `reply` values, else 0).",
                         example={"uptime": "ticks / 1000"},
                     ),
                     "description": Str(TEXT.description, example="A heartbeat every second while armed."),

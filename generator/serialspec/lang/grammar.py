@@ -1721,6 +1721,8 @@ EXAMPLE = Obj(
     required=("source", "direction", "printed", "command", "fields"),
     description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
     missing_hints={
+        "source": "the document and section the frame is printed in, e.g. `source: manual 4.2`; a top-level "
+        "`sources:` may name each document",
         "printed": "the frame as the document prints it, e.g. `printed: AA 01 02 01 32 DE`; `frame` only where the "
         "bytes sent differ from it",
         "fields": "the field values the frame carries; `fields: {}` for a message without fields",

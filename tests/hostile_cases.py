@@ -1217,6 +1217,13 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "01 32 DE`; `frame` only where the bytes sent differ from it)",
     ),
     (
+        "example without `source`",  # found writing LX-16A: which source, and that `sources:` names them, was unsaid
+        "tiny",
+        drop("examples/move_request/source"),
+        "examples.move_request: missing key 'source' (the document and section the frame is printed in, e.g. "
+        "`source: manual 4.2`; a top-level `sources:` may name each document)",
+    ),
+    (
         "example value missing",
         "tiny",
         drop("examples/move_request/fields/time"),

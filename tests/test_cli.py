@@ -414,3 +414,38 @@ def test_a_spec_the_c_target_cannot_generate_is_refused_in_one_line_naming_the_f
     assert everything.stderr.splitlines() == [
         "lamp.yaml: no c output: the request frame: element length of type i8 (the other outputs are written)"
     ]
+
+
+def camera_spec(folder: Path) -> str:
+    """A VISCA-like spec: cameras 0x81..0x87, 0x88 (inside the range) every camera; no `device.ids`."""
+    spec = folder / "cam.yaml"
+    spec.write_text(
+        "protocol: cam\ntitle: Cam\nbyte_order: little\nserial: {baudrate: 9600}\nframing:\n  elements:\n"
+        "    camera: {role: address, type: u8, range: [0x81, 0x88], broadcast: 0x88}\n"
+        "    code: {role: command, type: u8}\n    content: {role: content}\n    end: {role: trailer, value: FF}\n"
+        "commands:\n  home: {code: 4, request: {fields: {}}, response: {fields: {}}}\ndevice: {}\n",
+        encoding="utf-8",
+    )
+    return str(spec)
+
+
+def test_an_address_outside_its_range_names_a_broadcast_inside_it_no_more(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A broadcast value inside the range was named beside it, "129..136 (or 136)" (found writing Sony VISCA)."""
+    assert main(["decode", camera_spec(tmp_path), "90 04 ff", "--direction", "request"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec decode: 90 04 ff: camera = 144 is outside its range 129..136"
+    )
+
+
+def test_sim_without_id_names_the_default_id_not_an_id_typed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`serialspec sim visca.yaml` (an address range 0x81..0x88, no `device.ids`) said "--id 0 is outside the spec's
+    id range" of an --id nobody typed (found writing Sony VISCA as a new user)."""
+    assert main(["sim", camera_spec(tmp_path)]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec sim: no --id given, and the spec's default id 0 (`device.ids`: 0 when not given) is outside its "
+        "id range 129..136: give --id N, or `ids: [N]` under `device:`"
+    )

@@ -921,6 +921,29 @@ CASES["frame: reply_code, frame engine"] = Case(
     },
     commands=REPLY_CODED,
 )
+# A request code wider than the replies' command element (VISCA: 01 04 asked, 50 answered): the reply code's
+# expression takes the request's u16 code, and a reply-only command's code fits the reply element
+CASES["frame: reply_code, u16 request codes and u8 reply codes"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "code": {"role": "command", "type": "u16", "endian": "big", "directions": ["request"]},
+            "reply": {
+                "role": "command",
+                "type": "u8",
+                "directions": ["response"],
+                "reply_code": "(code + (code >> 8)) & 0xFF",
+            },
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+    commands={**REPLY_CODED, "other": {**REPLY_CODED["other"], "code": 0x0902}},
+)
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads
 SHARED_CODE = {
@@ -987,6 +1010,13 @@ CASES["replies sharing a code, by content size, frame engine"] = Case(
     {"v": "u16"},
     {"w": "u8", "x": "u32"},
     CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
+    commands=SHARED_REPLIES,
+)
+# ... and in a frame ended by its terminator, without a length (VISCA's inquiry replies, 90 50 ... FF)
+CASES["replies sharing a code, by content size, ended by a terminator"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "x": "u32"},
+    CASES["frame: ended by a terminator, no length"].framing,
     commands=SHARED_REPLIES,
 )
 # Messages picked by their leading constant (lang/model/discriminator.py), before sizes that overlap: RTCM 3's frame

@@ -72,6 +72,11 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
     ("change", "expected"),
     [
         (("title: Move", "title: Move\n    colour: red"), "unknown key 'colour'"),
+        # a key of the mapping one level lower: says where it goes (a response's `answers` written on its command)
+        (
+            ("title: Move", "title: Move\n    answers: move"),
+            "unknown key 'answers' (a key of `request:` or `response:`, one level lower; expected one of code,",
+        ),
         (("angle: i16", "angle: i16\n        angle: u8"), "duplicate key 'angle'"),
         (("angle: i16", "self: i16"), "reserved"),
         (("angle: i16", "from_: i16"), "is the Python name of a field 'from': call it 'from'"),
@@ -369,3 +374,28 @@ def test_a_spec_file_over_the_limit_is_refused_without_reading_it_whole(
         cwd=tmp_path,
     )
     assert result.stderr.splitlines()[0] == expected
+
+
+def test_a_request_code_too_wide_for_the_reply_command_element(tmp_path: Path) -> None:
+    """VISCA asks under a u16 (01 04) and answers under a u8 (50): a reply's code is checked against the reply's
+    command element (it was checked against either, so replies under 0x0904 were silently never decoded)."""
+    text = (
+        MINIMAL.replace(
+            "    code: {role: command, type: u8}",
+            "    code: {role: command, type: u16, directions: [request]}\n"
+            "    reply: {role: command, type: u8, directions: [response]}",
+        )
+        .replace("code: 1", "code: 0x0904")
+        .replace("covers: [code, content]", "covers: [length, content]")
+    )
+    text += "    response:\n      fields: {state: u8}\n"
+    lines = errors_of(tmp_path, text)
+    assert len(lines) == 1, lines
+    assert lines[0].endswith(
+        "commands.move.code: code 2308 does not fit the u8 command element of response frames (0..255); give that "
+        "element a `reply_code` (the code replies carry, as an expression of `code`)"
+    ), lines
+    coded = text.replace("directions: [response]}", 'directions: [response], reply_code: "code & 0xFF"}')
+    spec = tmp_path / "coded.yaml"
+    spec.write_text(coded, encoding="utf-8")
+    assert load_protocol(str(spec)).commands[0].response_code == 0x04

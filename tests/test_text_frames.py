@@ -192,10 +192,10 @@ def test_checksum_errors_are_checksum_errors() -> None:
     [
         ("GGA", {"satellites": 100}, "GP", RangeError, "GGA: satellites = 100 is outside its range 0..99"),
         ("GGA", {"latitude": 91.0}, "GP", RangeError, "GGA: latitude = 91.0 is outside its range 0..90"),
-        ("GGA", {"lat_hemisphere": "E"}, "GP", EncodeError, "GGA: lat_hemisphere must be one of N, S, got 'E'"),
+        ("GGA", {"lat_hemisphere": "E"}, "GP", EncodeError, "GGA: lat_hemisphere must be one of 'N', 'S', got 'E'"),
         ("GGA", {"satellites": 4.0}, "GP", EncodeError, "GGA: satellites must be an integer, got 4.0"),
         ("GGA", {"altitude": "high"}, "GP", EncodeError, "GGA: altitude must be a number, got 'high'"),
-        ("GGA", {"altitude_unit": "M,"}, "GP", EncodeError, "GGA: altitude_unit must be one of M, got 'M,'"),
+        ("GGA", {"altitude_unit": "M,"}, "GP", EncodeError, "GGA: altitude_unit must be one of 'M', got 'M,'"),
         ("GGA", {"speed": 1}, "GP", EncodeError, "GGA: unknown field 'speed'"),
         ("GGA", {}, "XX", EncodeError, "GGA: talker 'XX' is not one of GP, GN, GL, GA, BD"),
         ("GSV", {"satellites": [{}] * 5}, "GP", RangeError, "GSV: satellites has 5 groups, at most 4"),

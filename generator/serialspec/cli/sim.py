@@ -175,6 +175,12 @@ def _bus(args: argparse.Namespace, protocol: Protocol, module: ModuleType) -> An
     for device_id in ids:
         if not low <= device_id <= high or device_id == broadcast:
             also = f" ({broadcast} is the broadcast id)" if device_id == broadcast else ""
+            if not args.ids:  # the spec's default ids (0 where `device.ids` names none), not an --id typed
+                raise SerialspecError(
+                    f"no --id given, and the spec's default id {device_id} (`device.ids`: 0 when not given) is "
+                    f"outside its id range "
+                    f"{low}..{high}{also}: give --id N, or `ids: [N]` under `device:`"
+                )
             raise SerialspecError(f"--id {device_id} is outside the spec's id range {low}..{high}{also}")
     sizes: dict[str, int] = {}
     for text in args.sizes or ():

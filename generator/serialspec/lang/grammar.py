@@ -208,6 +208,15 @@ class MapOf(Shape):
         }
 
 
+def _mapping_keys(shape: Shape) -> Iterable[str]:
+    """The keys of the mapping a key's value is (a Ref's target's; each mapping a OneOf takes), else none."""
+    if isinstance(shape, Ref):
+        shape = shape.target()
+    if isinstance(shape, OneOf):
+        return [key for option in shape.options for key in _mapping_keys(option)]
+    return shape.keys if isinstance(shape, Obj) else ()
+
+
 def _did_you_mean(key: object, keys: Iterable[str]) -> str:
     """ "did you mean 'range'? " for a key one or two letters from one of `keys` (`rnage`), else ""."""
     if not isinstance(key, str):
@@ -251,13 +260,24 @@ class Obj(Shape):
                 # text cut at a comma in a flow mapping (`{description: a value, or 0}`)
                 cut = isinstance(key, str) and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", key)
                 hint = "; a comma inside `{...}` ends a value: quote text that holds one" if cut else ""
+                close = _did_you_mean(key, self.keys)
+                lower = "" if close or cut else self._lower_homes(key)
                 yield (
                     (*path, key),
-                    f"unknown key {key!r} ({_did_you_mean(key, self.keys)}expected one of "
-                    + (f"{', '.join(self.keys)}{hint})"),
+                    f"unknown key {key!r} ({close}{lower}expected one of " + (f"{', '.join(self.keys)}{hint})"),
                 )
             else:
                 yield from shape.check(item, (*path, key))
+
+    def _lower_homes(self, key: Any) -> str:
+        """ "a key of `response:`, one level lower; " for a key of the mapping one of this mapping's keys holds
+        (a command's `answers`, a key of its request or response), else ""."""
+        if not isinstance(key, str):
+            return ""
+        homes = [name for name, shape in self.keys.items() if key in _mapping_keys(shape)]
+        if not homes:
+            return ""
+        return f"a key of {' or '.join(f'`{name}:`' for name in homes)}, one level lower; "
 
     def _strays(self, value: dict[Any, Any], missing: list[str]) -> tuple[str, list[Any]]:
         """(the key, the unknown keys of `value`) when those are all entries of the one mapping key they fit, absent
@@ -1023,7 +1043,8 @@ COMMAND = Obj(
             "field: `93 3C 64` is note_on on channel 3, `E3 00 40` pitch_bend 8192 on channel 3, `F8` "
             "timing_clock. Constants of different widths pick as a prefix code, each read as every value of the "
             "widest it begins (`0x9` of 4 bits is 0x90..0x9F beside `0xF8` of 8 bits): none may begin another "
-            "(a `u4` 0xF beside `0xF8` would: they are then told apart by size, which needs a length element), "
+            "(a `u4` 0xF beside `0xF8` would: they are then told apart by size, which needs a length element or a "
+            "trailer), "
             "and the code is at most 256 values. Each "
             "message is sized by its own bytes (fixed fields, a count before what it counts, a NUL-terminated "
             "text last), so the frame needs no length; a stream parser finds each message's start by its "
@@ -1054,7 +1075,8 @@ COMMAND = Obj(
             "message, told apart by their content size like requests (a leading constant picks them likewise): "
             "decode without the request, the stream parser however the bytes are split, the C decoder and parser "
             "and the Wireshark dissector read a 20-byte reply under 0x03 as `measured_values_u16`. The frame needs "
-            "a length element, and no content size may fit two of them: a tie is refused in one line naming both "
+            "a length element, a trailer (VISCA's inquiry replies, `90 50 ... FF`) or a transform, and no content "
+            "size may fit two of them: a tie is refused in one line naming both "
             "(`code 0x03 in response frames is already used by 'read_measured_values', and a content of 40 bytes "
             "fits both`). A reply whose `answers` names a request answers it beside that request's own: the "
             "client's method returns whichever comes, whole (`ReadMeasuredValuesResponse | "
@@ -1270,7 +1292,10 @@ FRAME_ELEMENT = Obj(
             "alternative layouts, every layout's command element gives the same one, unless layouts are chosen by "
             "command (`layout:`): then only the commands whose replies travel in a layout that gives it have a reply "
             "code (HLK-LD2410: ACKs under `code | 0x0100` in the command layout, beside reports whose type byte is "
-            "their own code in a report layout without it).",
+            "their own code in a report layout without it). Where requests and replies have command elements of "
+            "their own (`directions:`), it goes on either, and `code` is the request's, which may be wider than "
+            'the reply\'s (a u16 request code, a u8 reply code: `reply_code: "code & 0xFF"`); without it, a code '
+            "that does not fit the replies' command element is refused in one line.",
             example="code | 0x40",
         ),
         "code": Str(
@@ -1692,6 +1717,8 @@ EXAMPLE = Obj(
     required=("source", "direction", "printed", "command", "fields"),
     description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
     missing_hints={
+        "source": "the document and section the frame is printed in, e.g. `source: manual 4.2`; a top-level "
+        "`sources:` may name each document",
         "printed": "the frame as the document prints it, e.g. `printed: AA 01 02 01 32 DE`; `frame` only where the "
         "bytes sent differ from it",
         "fields": "the field values the frame carries; `fields: {}` for a message without fields",
@@ -1796,9 +1823,11 @@ DEVICE_COMMAND = Obj(
             description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
         ),
         "reports": MapOf(
-            Str(),
+            OneOf((Int(), Str())),
             "Response field -> the state variable or memory entry it reports, or an expression of them where the "
-            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`).",
+            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`), or a number (a MediaTek "
+            "PMTK001 acknowledging command 220: `{command: 220, flag: 3}`; in a text `char` field a number is "
+            "written as its digit, the flag's letter `3`).",
         ),
         "moves": Obj(
             {
@@ -2182,9 +2211,9 @@ DEVICE = Obj(
                         example="fix",
                     ),
                     "values": MapOf(
-                        Str(),
-                        "Field -> an expression of state variables and memory entries it holds (other fields: the "
-                        "device's `reply` values, else 0).",
+                        OneOf((Int(), Str())),
+                        "Field -> an expression of state variables and memory entries it holds, or a number (other "
+                        "fields: the device's `reply` values, else 0).",
                         example={"uptime": "ticks / 1000"},
                     ),
                     "description": Str(TEXT.description, example="A heartbeat every second while armed."),

@@ -847,7 +847,8 @@ def _put_char(spec: TextField, value: Any, where: str) -> str:
         allowed = {str(m.value) for m in spec.letters}
         if isinstance(value, str) and value in allowed:
             return value
-        raise EncodeError(f"{where} must be one of {', '.join(sorted(allowed))}, got {shown(value)}")
+        # letters quoted as the value is shown: a number 3 is not the letter '3'
+        raise EncodeError(f"{where} must be one of {', '.join(map(repr, sorted(allowed)))}, got {shown(value)}")
     if not isinstance(value, str) or len(value) != 1:
         raise EncodeError(f"{where} must be one character, got {shown(value)}")
     return value

@@ -55,7 +55,13 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         checksum=function,
         minimum=int(element.minimum) if kind in ("value", "command") else 0,
         maximum=int(element.maximum) if kind in ("value", "command") else 0,
-        also=element.broadcast if kind in ("value", "command") else None,
+        also=(  # a broadcast value beside the range (one inside it is no other value)
+            element.broadcast
+            if kind in ("value", "command")
+            and element.broadcast is not None
+            and not element.minimum <= element.broadcast <= element.maximum
+            else None
+        ),
         skip=skip,
         request=element.checksum.from_request if element.checksum is not None else (),
         flag=layout.index(element.present_if[0]) if element.present_if[0] else -1,

@@ -408,13 +408,14 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 defaults[f.name] = field_default(f)
             else:
                 trailing = False
-        # a value of preset bit fields before fields without a default (a sync byte): its default, theirs REQUIRED
+        # a field with a default before fields without one (a reserved byte; a value of preset bit fields, a sync
+        # byte): its default, theirs REQUIRED
         # (the message class refuses it), as the message class's parameters
         after_default = False
         for f in fields:
             if f.name in defaults or f.name in sequences:
                 continue
-            if isinstance(f, Scalar) and f.bits and field_default(f):
+            if field_default(f):
                 defaults[f.name] = field_default(f)
                 after_default = True
             elif after_default:

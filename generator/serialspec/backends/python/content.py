@@ -303,9 +303,10 @@ class PackageCode:
         return [element_scalar(element) for element in elements]
 
     def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
-        # Defaults only on a trailing run of fields that all have one: classes stay positional. A value made of bit
-        # fields that are all constants or defaults (a sync byte) has its bits class's as a default wherever it is;
-        # the fields after it without one get REQUIRED, which __new__ refuses (positional calls keep working).
+        # Defaults only on a trailing run of fields that all have one: classes stay positional. A field with a default
+        # before fields without one (a reserved byte, LX-16A's mode write; a value made of bit fields that are all
+        # constants or defaults, a sync byte, as its bits class's) has it wherever it is; the fields after it without
+        # one get REQUIRED, which __new__ refuses (positional calls keep working).
         given = {f.name: field_default(f) for f in fields} if defaults else {}
         trailing: set[str] = set()
         for f in reversed(fields):
@@ -318,7 +319,7 @@ class PackageCode:
             default = given.get(f.name, "")
             if f.name in trailing:
                 attributes.append(Attribute(f.name, annotation(f), doc_line(f), default))
-            elif default and isinstance(f, Scalar) and f.bits:
+            elif default:
                 attributes.append(Attribute(f.name, annotation(f), doc_line(f), default, in_class=False))
                 after_default = True
             else:

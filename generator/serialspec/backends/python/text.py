@@ -9,6 +9,7 @@ from typing import assert_never
 
 from serialspec.backends.python.render import one_line
 from serialspec.backends.python.simulator import period_source, report_source
+from serialspec.lang import expression
 from serialspec.lang.model import (
     Direction,
     Protocol,
@@ -30,6 +31,11 @@ def text_package(protocol: Protocol, text: TextFrame) -> dict[str, str]:
     if text.device is not None:
         files["simulator.py"] = "\n".join(_simulator(protocol, text, text.device)) + "\n"
     return files
+
+
+def digit_source(parsed: expression.Expr) -> str:
+    """A number reported in a char field, as a function of `get`: its digits (3 -> "3")."""
+    return f"lambda get: str(int({expression.render(parsed, lambda n: f'get({n!r})')}))"
 
 
 def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Iterator[str]:
@@ -78,7 +84,12 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
             if answer is not None and answer.sets:
                 args.append(f"sets={answer.sets!r}")
             if answer is not None and answer.reports:
-                args.append(f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in answer.reports.items())}}}")
+                # a char field (PMTK001's flag, letters 0..3) takes the digit of the number reported
+                chars = {f.name for f in replied if isinstance(f, TextField) and f.kind == "char"}
+                sources = (
+                    f"{k!r}: {digit_source(v) if k in chars else report_source(v)}" for k, v in answer.reports.items()
+                )
+                args.append(f"reports={{{', '.join(sources)}}}")
             if answer is not None and answer.echoes:
                 args.append(f"echoes={answer.echoes!r}")
             if request.then:  # the response that ends each answer, after the reply

@@ -120,8 +120,20 @@ class Commands(FieldResolver):
             self.error(where, "response frames carry no command code (the element is limited to requests or constant)")
             return commands
         low, high = int(element.type.minimum), int(element.type.maximum)
+        # the codes the expression takes are the requests' (VISCA: a u16 request code, a u8 reply code)
+        asked = next(
+            (
+                e
+                for layout in framing.alternatives[Direction.REQUEST]
+                for e in layout.elements
+                if e.role == "command" and e.type is not None and not e.constant
+            ),
+            element,
+        )
+        assert asked.type is not None
+        first, last = int(asked.type.minimum), int(asked.type.maximum)
         try:
-            expression.bounds(expr, {"code": (low, high)})  # refuses what could grow without limit
+            expression.bounds(expr, {"code": (first, last)})  # refuses what could grow without limit
         except expression.ExpressionError as exc:
             self.error(where, str(exc))
             return commands
@@ -137,7 +149,7 @@ class Commands(FieldResolver):
             if (
                 isinstance(command.code, int)
                 and not isinstance(command.code, bool)
-                and low <= command.code <= high
+                and first <= command.code <= last
                 and replies
             ):
                 try:
@@ -553,26 +565,37 @@ class Commands(FieldResolver):
                     ("commands", command.name, "code"),
                     "its frames have no command field, so no code",
                 )
-            # a code fits the command element of some layout it may travel in (alternatives told apart by header:
-            # encode sends it in the first that holds it, MSP v2's u16 codes beside v1's u8 ones)
-            elements = [
-                e
-                for d in directions
-                for layout in (
-                    (layouts[d],) if framing.by_command else framing.alternatives.get(d, (framing.layouts[d],))
-                )
-                for e in layout.elements
-                if e.role == "command" and e.type is not None and not layout.error
-            ]
-            code = command.code
-            if elements and code is not None and not any(fits(e, code) for e in elements):
-                element = elements[0]
-                assert element.type is not None
-                low, high = element.type.minimum, element.type.maximum
-                self.error(
-                    ("commands", command.name, "code"),
-                    f"code {code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
-                )
+            # in each direction, the code its frames carry fits the command element of some layout it may travel
+            # in (alternatives told apart by header: encode sends it in the first that holds it, MSP v2's u16 codes
+            # beside v1's u8 ones); a request's u16 code is not carried by a u8 element of replies (VISCA)
+            for d in sorted(directions, key=lambda d: d.value != "request"):
+                elements = [
+                    e
+                    for layout in (
+                        (layouts[d],) if framing.by_command else framing.alternatives.get(d, (framing.layouts[d],))
+                    )
+                    for e in layout.elements
+                    if e.role == "command" and e.type is not None and not layout.error and d in e.directions
+                ]
+                code = command.wire_code(d)
+                if any(m.error_reply for m in command.messages() if m.direction == d):
+                    continue  # an error reply carries the code of the request it refuses
+                if elements and code is not None and not any(fits(e, code) for e in elements):
+                    element = elements[0]
+                    assert element.type is not None
+                    low, high = element.type.minimum, element.type.maximum
+                    reply = d == Direction.RESPONSE and command.response_code is None and len(directions) > 1
+                    self.error(
+                        ("commands", command.name, "code"),
+                        f"code {code} does not fit the {element.type.name} command element"
+                        f"{' of ' + d.value + ' frames' if len(element.directions) < 2 else ''} ({low:g}..{high:g})"
+                        + (
+                            "; give that element a `reply_code` (the code replies carry, as an expression of `code`)"
+                            if reply
+                            else ""
+                        ),
+                    )
+                    break
         for direction, layout in framing.layouts.items():
             sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
@@ -601,7 +624,10 @@ class Commands(FieldResolver):
                         # size (iRobot's sensor queries): no length needed
                         continue
                     kind = direction.value
-                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                    if any(
+                        alt.length is None and not alt.trailer and alt.transparency is None
+                        for alt in framing.alternatives.get(direction, (layout,))
+                    ):
                         shared = (
                             f"{what} in {kind} frames is already used by {users[0][0].name!r}; {kind}s that share "
                             "a code"
@@ -618,7 +644,8 @@ class Commands(FieldResolver):
                         reason = why_not_picked(alike)
                         self.error(
                             ("commands", users[1][0].name),
-                            f"{shared} are told apart by their content size, which needs a length element{reason}"
+                            f"{shared} are told apart by their content size, which needs a length element, a trailer "
+                            f"or a transform{reason}"
                             f"{other}",
                         )
                     elif discriminator([m for _, m in users]) is None:

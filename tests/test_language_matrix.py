@@ -2143,11 +2143,11 @@ def test_an_answer_ended_by_another_line_through_every_output(many: bool, tmp_pa
 
 
 def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
-    """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value
-    right after the code) beside the case's plain sentences: C and
-    Wireshark refuse it in one line; the markdown page shows the labels; the generated package round-trips random
-    messages (labels left out where a value is None) and finds them byte by byte among garbage and other sentences;
-    the simulator sends it."""
+    """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value right
+    after the code) beside the case's plain sentences: C refuses it in one line (tests/test_wireshark_text.py holds the
+    dissector to decode); the markdown page shows the labels; the generated package round-trips random messages (labels
+    left out where a value is None) and finds them byte by byte among garbage and other sentences; the simulator sends
+    it."""
     from serialspec.backends import Unsupported, emit
     from serialspec.runtime.text import TextField, TextRepeat
     from test_text_frames import sentence_values
@@ -2181,7 +2181,7 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
     assert protocol.text is not None
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name in ("c", "wireshark"):
+        if emitter.name == "c":
             with pytest.raises(Unsupported, match=r"^a message's own text layout \(`text:`\)$"):
                 emitter.files(protocol)
             continue
@@ -2296,10 +2296,11 @@ def test_a_decimal_text_checksum_through_every_output() -> None:
 
 
 def test_messages_found_by_their_code_alone_through_every_output() -> None:
-    """A message's own `text:` without a `start` (found by its code: Roboteq's `A=12:13`) and with `after_code`
-    (`""`: the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins:
-    C and Wireshark refuse it in one line; the reference says how it is written; random messages round trip and are
-    found byte by byte among the others; codes that a frame could not tell apart are refused, one line each."""
+    """A message's own `text:` without a `start` (found by its code: Roboteq's `A=12:13`) and with `after_code` (`""`:
+    the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins: C refuses
+    it in one line (tests/test_wireshark_text.py holds the dissector to decode); the reference says how it is written;
+    random messages round trip and are found byte by byte among the others; codes that a frame could not tell apart are
+    refused, one line each."""
 
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["glued"] = {
@@ -2315,7 +2316,7 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
             "fields": {"vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}}},
         },
     }
-    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    files = python_and_markdown(case, {"c": r"^a message's own text layout \(`text:`\)$"})
     docs = files["docs/matrix_text.md"]
     assert "found by its code: the code, the first field right after the code" in docs, docs
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
@@ -2443,9 +2444,10 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
 
 
 def test_labels_glued_to_their_values_through_every_output() -> None:
-    """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's
-    `D1800T1500`, the first value labelled with the code): C and Wireshark refuse them in one line; the reference
-    says how they are written; random messages round trip and stream; what a frame could not tell apart is refused."""
+    """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's `D1800T1500`, the
+    first value labelled with the code): C refuses them in one line (tests/test_wireshark_text.py holds the dissector to
+    decode); the reference says how they are written; random messages round trip and stream; what a frame could not tell
+    apart is refused."""
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["move"] = {
         "code": "MV",
@@ -2467,7 +2469,7 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
             "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
         },
     }
-    files = python_and_markdown(case, r"^a message's own text layout \(`text:`\)$")
+    files = python_and_markdown(case, {"c": r"^a message's own text layout \(`text:`\)$"})
     assert "written as its label glued to its value" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from serialspec.runtime.text import TextField
 from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
 from test_language_matrix import TEXT_CASE
-from test_text_frames import sentence_values
+from test_text_frames import field_values, sentence_values
 
 pytestmark = pytest.mark.slow
 TSHARK = shutil.which("tshark")
@@ -128,7 +128,69 @@ ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators
     "code": "NT",
     "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
 }
-BY_DIRECTION = {"ws_text_lines": copy.deepcopy(LINES) | {"protocol": "ws_text_lines"}, "ws_text_one_way": ONE_WAY}
+# Messages in their own text: inside a start and an ending, with labels, a list and a value after the code (GRBL's
+# `<Idle|MPos:…>`); found by their code, glued to it (LSS's `D1800`) beside a longer code, with their own separator
+# and list (Roboteq's `A=12:13`); labels glued to their values, with a separator (G-code's `X10.5`) and without
+# (LSS's `D1800T1500`).
+LAYOUTS = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_layouts"}
+LAYOUTS["commands"] |= {
+    "report": {
+        "code": "RP",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "<", "end": ">", "separator": "|", "named": "=", "list": ","},
+            "fields": {
+                "sub": {"label": "RP", "type": "integer", "range": [0, 9]},
+                "lvl": {"label": "LV", "type": "integer", "range": [0, 99]},
+                "pos": {
+                    "label": "P",
+                    "type": "repeat",
+                    "count": 2,
+                    "fields": {"x": {"type": "decimal", "precision": 1}},
+                },
+                "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
+            },
+        },
+    },
+    "glued": {
+        "code": "GL",
+        "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
+    },
+    "longer": {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}},
+    "pairs": {
+        "code": "PR",
+        "response": {
+            "unsolicited": True,
+            "text": {"separator": "=", "list": ":"},
+            "fields": {"vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}}},
+        },
+    },
+    "move": {
+        "code": "MV",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": "", "separator": ""},
+            "fields": {
+                "at": {"label": "MV", "type": "integer"},
+                "time": {"label": "T", "type": "integer"},
+                "speed": {"label": "SD", "type": "decimal"},
+            },
+        },
+    },
+    "words": {
+        "code": "GW",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": ""},
+            "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
+        },
+    },
+}
+BY_DIRECTION = {
+    "ws_text_lines": copy.deepcopy(LINES) | {"protocol": "ws_text_lines"},
+    "ws_text_one_way": ONE_WAY,
+    "ws_text_layouts": LAYOUTS,
+}
 
 
 @pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
@@ -158,9 +220,12 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
         frames, wanted, asked = [], [], None
         for s in framing.sentences:
             values = data.draw(sentence_values(s))
-            for item in s.fields:  # a text to the end of the line holds separators
-                if isinstance(item, TextField) and item.rest:
+            for item in s.fields:
+                if isinstance(item, TextField) and item.rest:  # a text to the end of the line holds separators
                     values[item.name] = f"a{framing.separator}b {framing.separator}{values[item.name] or ''}"
+                if isinstance(item, TextField) and item.label == s.code and values[item.name] is None:
+                    # the value labelled with the code, right after it (GRBL's `Hold:0`, LSS's `D1800`)
+                    values[item.name] = data.draw(field_values(item).filter(lambda v: v is not None))
             talker = data.draw(st.sampled_from(talkers))
             frame = framing.encode(s.code, values, talker, direction=s.direction)
             frames.append((s.direction, frame))

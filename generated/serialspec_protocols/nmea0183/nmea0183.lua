@@ -32,20 +32,20 @@ local SPEC = {
         direction = "response",
         title = "Global Positioning System Fix Data",
         fields = {
-          {name = "utc", title = "utc"},
-          {name = "latitude", title = "latitude"},
-          {name = "lat_hemisphere", title = "lat_hemisphere"},
-          {name = "longitude", title = "longitude"},
-          {name = "lon_hemisphere", title = "lon_hemisphere"},
-          {name = "quality", title = "quality"},
-          {name = "satellites", title = "satellites"},
-          {name = "hdop", title = "hdop"},
-          {name = "altitude", title = "altitude"},
-          {name = "altitude_unit", title = "altitude_unit"},
-          {name = "separation", title = "separation"},
-          {name = "separation_unit", title = "separation_unit"},
-          {name = "dgps_age", title = "dgps_age"},
-          {name = "dgps_station", title = "dgps_station"},
+          {name = "utc", title = "utc", label = ""},
+          {name = "latitude", title = "latitude", label = ""},
+          {name = "lat_hemisphere", title = "lat_hemisphere", label = ""},
+          {name = "longitude", title = "longitude", label = ""},
+          {name = "lon_hemisphere", title = "lon_hemisphere", label = ""},
+          {name = "quality", title = "quality", label = ""},
+          {name = "satellites", title = "satellites", label = ""},
+          {name = "hdop", title = "hdop", label = ""},
+          {name = "altitude", title = "altitude", label = ""},
+          {name = "altitude_unit", title = "altitude_unit", label = ""},
+          {name = "separation", title = "separation", label = ""},
+          {name = "separation_unit", title = "separation_unit", label = ""},
+          {name = "dgps_age", title = "dgps_age", label = ""},
+          {name = "dgps_station", title = "dgps_station", label = ""},
         },
       },
       only = "response",
@@ -57,18 +57,18 @@ local SPEC = {
         direction = "response",
         title = "Recommended Minimum Specific GNSS Data",
         fields = {
-          {name = "utc", title = "utc"},
-          {name = "status", title = "status"},
-          {name = "latitude", title = "latitude"},
-          {name = "lat_hemisphere", title = "lat_hemisphere"},
-          {name = "longitude", title = "longitude"},
-          {name = "lon_hemisphere", title = "lon_hemisphere"},
-          {name = "speed", title = "speed"},
-          {name = "course", title = "course"},
-          {name = "date", title = "date"},
-          {name = "variation", title = "variation"},
-          {name = "variation_direction", title = "variation_direction"},
-          {name = "mode", title = "mode"},
+          {name = "utc", title = "utc", label = ""},
+          {name = "status", title = "status", label = ""},
+          {name = "latitude", title = "latitude", label = ""},
+          {name = "lat_hemisphere", title = "lat_hemisphere", label = ""},
+          {name = "longitude", title = "longitude", label = ""},
+          {name = "lon_hemisphere", title = "lon_hemisphere", label = ""},
+          {name = "speed", title = "speed", label = ""},
+          {name = "course", title = "course", label = ""},
+          {name = "date", title = "date", label = ""},
+          {name = "variation", title = "variation", label = ""},
+          {name = "variation_direction", title = "variation_direction", label = ""},
+          {name = "mode", title = "mode", label = ""},
         },
       },
       only = "response",
@@ -80,15 +80,15 @@ local SPEC = {
         direction = "response",
         title = "Track Made Good and Ground Speed",
         fields = {
-          {name = "course_true", title = "course_true"},
-          {name = "true_reference", title = "true_reference"},
-          {name = "course_magnetic", title = "course_magnetic"},
-          {name = "magnetic_reference", title = "magnetic_reference"},
-          {name = "speed_knots", title = "speed_knots"},
-          {name = "knots_unit", title = "knots_unit"},
-          {name = "speed_kmh", title = "speed_kmh"},
-          {name = "kmh_unit", title = "kmh_unit"},
-          {name = "mode", title = "mode"},
+          {name = "course_true", title = "course_true", label = ""},
+          {name = "true_reference", title = "true_reference", label = ""},
+          {name = "course_magnetic", title = "course_magnetic", label = ""},
+          {name = "magnetic_reference", title = "magnetic_reference", label = ""},
+          {name = "speed_knots", title = "speed_knots", label = ""},
+          {name = "knots_unit", title = "knots_unit", label = ""},
+          {name = "speed_kmh", title = "speed_kmh", label = ""},
+          {name = "kmh_unit", title = "kmh_unit", label = ""},
+          {name = "mode", title = "mode", label = ""},
         },
       },
       only = "response",
@@ -100,12 +100,18 @@ local SPEC = {
         direction = "response",
         title = "GNSS DOP and Active Satellites",
         fields = {
-          {name = "selection", title = "selection"},
-          {name = "fix", title = "fix"},
-          {name = "used", count = 12, max = 0, fields = {{name = "prn", title = "prn"}}},
-          {name = "pdop", title = "pdop"},
-          {name = "hdop", title = "hdop"},
-          {name = "vdop", title = "vdop"},
+          {name = "selection", title = "selection", label = ""},
+          {name = "fix", title = "fix", label = ""},
+          {
+            name = "used",
+            count = 12,
+            max = 0,
+            label = "",
+            fields = {{name = "prn", title = "prn", label = ""}},
+          },
+          {name = "pdop", title = "pdop", label = ""},
+          {name = "hdop", title = "hdop", label = ""},
+          {name = "vdop", title = "vdop", label = ""},
         },
       },
       only = "response",
@@ -117,18 +123,19 @@ local SPEC = {
         direction = "response",
         title = "GNSS Satellites in View",
         fields = {
-          {name = "sentences", title = "sentences"},
-          {name = "sentence", title = "sentence"},
-          {name = "in_view", title = "in_view"},
+          {name = "sentences", title = "sentences", label = ""},
+          {name = "sentence", title = "sentence", label = ""},
+          {name = "in_view", title = "in_view", label = ""},
           {
             name = "satellites",
             count = 0,
             max = 4,
+            label = "",
             fields = {
-              {name = "prn", title = "prn"},
-              {name = "elevation", title = "elevation"},
-              {name = "azimuth", title = "azimuth"},
-              {name = "snr", title = "snr"},
+              {name = "prn", title = "prn", label = ""},
+              {name = "elevation", title = "elevation", label = ""},
+              {name = "azimuth", title = "azimuth", label = ""},
+              {name = "snr", title = "snr", label = ""},
             },
           },
         },
@@ -136,6 +143,7 @@ local SPEC = {
       only = "response",
     },
   },
+  layouts = {},
   alone = {},
 }
 
@@ -227,24 +235,90 @@ local function split(data, first, last, separator)
   end
 end
 
--- the message found by its own code at data[first..last] (the talker left out: an ELM327's `41 0C`, the longest
--- code that fits, then its `after_code` and its own ending), its fields' parts and where they end; nil: none fits
+local function ends_with(text, suffix)
+  return suffix == "" or (#text >= #suffix and text:sub(-#suffix) == suffix)
+end
+
+-- the message found by its own code at data[first..last] (the talker left out: an ELM327's `41 0C`, the longest code
+-- that fits, then what follows it and its own ending): the message, where its code is, and where the text of its
+-- fields begins and ends (nil, nil: the code alone); nil when none fits
 local function found_alone(data, first, last, direction)
   local text = data:sub(first, last)
   for _, item in ipairs(SPEC.alone) do
     if item.direction == direction and text:sub(1, #item.code) == item.code then
       local message = SPEC.messages[item.code][direction]
       local layout, rest = message.layout, text:sub(#item.code + 1)
-      if rest == "" then return message, {}, last end
-      if rest:sub(1, #layout.after) == layout.after
-        and (layout.ending == "" or rest:sub(-#layout.ending) == layout.ending) then
-        local inner_first, inner_last = first + #item.code + #layout.after, last - #layout.ending
-        if inner_last < inner_first then return message, {}, inner_last end
-        return message, split(data, inner_first, inner_last, layout.separator), inner_last
+      if rest == "" then return message, first, nil, nil end
+      if rest:sub(1, #layout.after) == layout.after and ends_with(rest:sub(#layout.after + 1), layout.ending) then
+        return message, first, first + #item.code + #layout.after, last - #layout.ending
       end
     end
   end
   return nil
+end
+
+-- a piece ({first, text}) cut at `list` (a repeat's values in a message's own text); itself where there is none
+local function cut(data, piece, list)
+  if list == "" then return {piece} end
+  return split(data, piece[1], piece[1] + #piece[2] - 1, list)
+end
+
+-- the pieces of data[first..last] between `separator`s ({first, text} each), each cut again at `list`
+local function pieces(data, first, last, separator, list)
+  local out = {}
+  for _, part in ipairs(split(data, first, last, separator)) do
+    for _, piece in ipairs(cut(data, part, list)) do out[#out + 1] = piece end
+  end
+  return out
+end
+
+-- {label, value ({first, text}), found} of each labelled value of a message's own text: `named` between label and
+-- value in each part; glued (`named: ""`), the longest label a piece starts with, and without a separator the run
+-- of number characters after it (LSS's `D1800T1500`)
+local function labelled_pairs(data, layout, parts, first, last)
+  local found = {}
+  if not layout.glued then
+    for _, part in ipairs(parts) do
+      local at = part[2]:find(layout.named, 1, true)
+      if at then
+        found[#found + 1] = {part[2]:sub(1, at - 1), {part[1] + at - 1 + #layout.named, part[2]:sub(at + #layout.named)},
+          true}
+      else
+        found[#found + 1] = {part[2], {part[1] + #part[2], ""}, false}
+      end
+    end
+    return found
+  end
+  local function label_at(text, at)
+    for _, label in ipairs(layout.labels) do
+      if text:sub(at, at + #label - 1) == label then return label end
+    end
+    return nil
+  end
+  if layout.separator ~= "" then
+    for _, part in ipairs(last >= first and split(data, first, last, layout.separator) or {}) do
+      local label = label_at(part[2], 1)
+      if label then
+        found[#found + 1] = {label, {part[1] + #label, part[2]:sub(#label + 1)}, true}
+      else
+        found[#found + 1] = {part[2], {part[1] + #part[2], ""}, false}
+      end
+    end
+    return found
+  end
+  local text, at = data:sub(first, last), 1
+  while at <= #text do
+    local label = label_at(text, at)
+    if label == nil then
+      found[#found + 1] = {text:sub(at), {first + #text, ""}, false}
+      return found
+    end
+    local stop = at + #label
+    while stop <= #text and text:sub(stop, stop):match("[%d%+%-%.]") do stop = stop + 1 end
+    found[#found + 1] = {label, {first + at - 1 + #label, text:sub(at + #label, stop - 1)}, true}
+    at = stop
+  end
+  return found
 end
 
 local function add_field(tree, tvb, pf, part)
@@ -252,6 +326,65 @@ local function add_field(tree, tvb, pf, part)
     tree:add(pf, tvb(0, 0), "")
   else
     tree:add(pf, tvb(part[1] - 1, #part[2]), part[2])
+  end
+end
+
+-- a message's fields from its parts in order, from parts[at] (an address's from the digits read before the code; a
+-- text to the end of the line up to `stop`, separators included)
+local function add_positional(root, tvb, data, message, parts, at, stop, address_part)
+  for _, item in ipairs(message.fields) do
+    if item.fields then
+      local groups = item.count
+      if groups == 0 then
+        groups = math.max(0, math.min(item.max, math.floor((#parts - at + #item.fields) / #item.fields)))
+      end
+      for _ = 1, groups do
+        for _, inner in ipairs(item.fields) do
+          add_field(root, tvb, inner.pf, parts[at])
+          at = at + 1
+        end
+      end
+    elseif item.address then -- read before the code
+      add_field(root, tvb, item.pf, address_part)
+    elseif item.rest then -- the rest of the line, separators included
+      local part = parts[at] and {parts[at][1], data:sub(parts[at][1], stop)} or nil
+      add_field(root, tvb, item.pf, part)
+      at = math.max(at + 1, #parts + 1)
+    else
+      add_field(root, tvb, item.pf, parts[at])
+      at = at + 1
+    end
+  end
+  if at <= #parts then root:add_proto_expert_info(e_malformed, "more fields than the message has") end
+end
+
+-- a message's fields found by their labels ({label, value, found} each, in any order; an absent one is empty), a
+-- repeat's values cut at the layout's `list`; an unknown label, one sent twice or a repeat of the wrong count is an
+-- error (shown as a malformed sentence)
+local function add_labelled(root, tvb, data, message, labelled, address_part)
+  local layout, values = message.layout, {}
+  for _, pair in ipairs(labelled) do
+    local label, value, found = pair[1], pair[2], pair[3]
+    if not found or not layout.labelled[label] then error(message.command .. ": unknown label " .. label) end
+    if values[label] then error(message.command .. ": label " .. label .. " sent twice") end
+    values[label] = value
+  end
+  for _, item in ipairs(message.fields) do
+    local value = values[item.label]
+    if item.address then
+      add_field(root, tvb, item.pf, address_part)
+    elseif item.fields then
+      local texts, size = value and cut(data, value, layout.list) or {}, #item.fields
+      if #texts % size ~= 0 or (value and item.count > 0 and #texts ~= item.count * size)
+        or (item.max and item.max > 0 and #texts > item.max * size) then
+        error(string.format("%s: %s has %d values", message.command, item.name, #texts))
+      end
+      for k = 1, #texts, size do
+        for i, inner in ipairs(item.fields) do add_field(root, tvb, inner.pf, texts[k + i - 1]) end
+      end
+    else
+      add_field(root, tvb, item.pf, value)
+    end
   end
 end
 
@@ -306,29 +439,81 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
   local parts = split(data, body, stop)
   local address = parts[1][2]
   local talker, code = address:sub(1, SPEC.talker), address:sub(SPEC.talker + 1)
+  local head, head_size = parts[1][1], #address -- talker and code, shown under the command's name
+  local message, at, labelled = nil, 2, nil
+  -- a message in its own text, inside its start and ending (GRBL's `<Idle|MPos:…>`)
+  local text = data:sub(body, stop)
+  for _, layout in ipairs(SPEC.layouts) do
+    if text:sub(1, #layout.start) == layout.start and ends_with(text:sub(#layout.start + 1), layout.ending) then
+      parts = split(data, body + #layout.start, stop - #layout.ending, layout.separator)
+      local first = parts[1]
+      talker = first[2]:sub(1, SPEC.talker)
+      local after = first[2]:sub(SPEC.talker + 1)
+      code = after
+      local named = layout.named ~= "" and after:find(layout.named, 1, true)
+      if named then code = after:sub(1, named - 1) end
+      local by_direction = SPEC.messages[code]
+      message = by_direction and by_direction[by_direction.only or direction]
+      if message == nil then error("unknown text code " .. code) end
+      if message.layout == nil or message.layout.id ~= layout.id then
+        error(message.command .. " is not sent as " .. layout.start .. "…" .. layout.ending)
+      end
+      head, head_size = first[1], #first[2]
+      if SPEC.talker > 0 then root:add(f_talker, tvb(first[1] - 1, #talker), talker) end
+      root:add(f_code, tvb(first[1] - 1 + #talker, #code), code)
+      if layout.named ~= "" then
+        local labelled_parts = {}
+        if after ~= code then labelled_parts[1] = {first[1] + SPEC.talker, after} end -- GRBL's `Hold:0`
+        for i = 2, #parts do labelled_parts[#labelled_parts + 1] = parts[i] end
+        labelled = labelled_pairs(data, layout, labelled_parts)
+      else
+        local inner = {}
+        for i = 2, #parts do
+          for _, piece in ipairs(cut(data, parts[i], layout.list)) do inner[#inner + 1] = piece end
+        end
+        parts, at = inner, 1
+      end
+      break
+    end
+  end
   local by_direction = SPEC.messages[code]
-  local message = by_direction and by_direction[by_direction.only or direction]
   local bare = asked and SPEC.messages[asked] and SPEC.messages[asked].response
   local coded = by_direction and by_direction[direction] and not by_direction[direction].bare
   local plain = coded and not by_direction[direction].layout -- a code of the framing's own text
-  local head, head_size = parts[1][1], #address -- talker and code, shown under the command's name
-  local at, own, own_parts, own_last = 2, nil, nil, nil
-  if #SPEC.alone > 0 and not plain then
-    own, own_parts, own_last = found_alone(data, body + SPEC.talker, stop, direction)
+  local own, code_at, inner_first, inner_last = nil, nil, nil, nil
+  if message == nil and #SPEC.alone > 0 and not plain then
+    own, code_at, inner_first, inner_last = found_alone(data, body + SPEC.talker, stop, direction)
   end
-  if own then -- found by its own code: its fields after it
-    local at_code = parts[1][1] + SPEC.talker
+  if message then -- read in its own text above
+  elseif own then -- found by its own code: its fields after it
+    local layout = own.layout
     if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, SPEC.talker), talker) end
-    root:add(f_code, tvb(at_code - 1, #own.code), own.code)
-    message, parts, stop, at, head_size = own, own_parts, own_last, 1, SPEC.talker + #own.code
+    root:add(f_code, tvb(code_at - 1, #own.code), own.code)
+    message, at, head_size = own, 1, SPEC.talker + #own.code
+    if layout.glued then -- the code is the label of the value right after it, where a field has it as its label
+      local from = layout.labelled[own.code] and code_at or inner_first
+      labelled = labelled_pairs(data, layout, nil, from or code_at, inner_last or (code_at + #own.code - 1))
+      if inner_first == nil and not layout.labelled[own.code] then labelled = {} end
+    elseif layout.named ~= "" then
+      labelled = labelled_pairs(data, layout, inner_first and split(data, inner_first, inner_last, layout.separator)
+        or {})
+    else
+      parts = inner_first and pieces(data, inner_first, inner_last, layout.separator, layout.list) or {}
+      stop = inner_last or stop
+    end
+    if inner_first and inner_last < inner_first and not layout.glued then -- the text of its fields is empty
+      parts, labelled = {}, labelled and {} or nil
+    end
   elseif direction == "response" and bare and bare.bare and not coded then
     message, at = bare, 1 -- a reply of values alone, right after its request: every part a field
-  elseif message == nil then
-    root:add(f_code, tvb(parts[1][1] - 1, #address), code)
-    root:add_proto_expert_info(e_malformed, "unknown text code " .. code)
-    info[#info + 1] = "unknown " .. code
-    return nil
   else
+    message = by_direction and by_direction[by_direction.only or direction]
+    if message == nil then
+      root:add(f_code, tvb(parts[1][1] - 1, #address), code)
+      root:add_proto_expert_info(e_malformed, "unknown text code " .. code)
+      info[#info + 1] = "unknown " .. code
+      return nil
+    end
     if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, #talker), talker) end
     root:add(f_code, tvb(parts[1][1] - 1 + #talker, #code), code)
   end
@@ -337,30 +522,11 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
   root:set_text(string.format("%s %s %s%s", SPEC.title, message.direction, message.title,
     checked == false and " [bad checksum]" or ""))
   info[#info + 1] = message.command
-  for _, item in ipairs(message.fields) do
-    if item.fields then
-      local groups = item.count
-      if groups == 0 then
-        groups = math.max(0, math.min(item.max, math.floor((#parts - at + #item.fields) / #item.fields)))
-      end
-      for _ = 1, groups do
-        for _, inner in ipairs(item.fields) do
-          add_field(root, tvb, inner.pf, parts[at])
-          at = at + 1
-        end
-      end
-    elseif item.address then -- read before the code
-      add_field(root, tvb, item.pf, address_part)
-    elseif item.rest then -- the rest of the line, separators included
-      local part = parts[at] and {parts[at][1], data:sub(parts[at][1], stop)} or nil
-      add_field(root, tvb, item.pf, part)
-      at = math.max(at + 1, #parts + 1)
-    else
-      add_field(root, tvb, item.pf, parts[at])
-      at = at + 1
-    end
+  if labelled then
+    add_labelled(root, tvb, data, message, labelled, address_part)
+  else
+    add_positional(root, tvb, data, message, parts, at, stop, address_part)
   end
-  if at <= #parts then root:add_proto_expert_info(e_malformed, "more fields than the message has") end
   return message
 end
 

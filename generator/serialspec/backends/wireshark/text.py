@@ -11,22 +11,53 @@ from serialspec.backends.common.render import render
 from serialspec.backends.common.text import collapse
 from serialspec.backends.common.text_frames import WIRESHARK_TAKES, refuse_text_frames
 from serialspec.backends.wireshark.dissector import lua
-from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextLayout, TextMessage, TextRepeat
 
 
 def _field(f: TextField) -> dict[str, Any]:
-    # `rest`: the rest of the line, separators included (the message's last field)
-    # `address`: the framing's, every message's first field, its digits right after the start (LSS's servo id)
-    return {"name": f.name, "title": f.name, "rest": f.rest or None, "address": f.address or None}
+    # `rest`: the rest of the line, separators included (the message's last field); `address`: the framing's,
+    # every message's first field, its digits right after the start (LSS's servo id); `label`: in a message's own
+    # text with labels, the label its value follows
+    return {"name": f.name, "title": f.name, "rest": f.rest or None, "address": f.address or None, "label": f.label}
+
+
+def _layout(m: TextMessage, layout: TextLayout, ids: dict[TextLayout, int]) -> dict[str, Any]:
+    """A message's own text (`text:`) as runtime/text.py reads it: its start and ending, separator, labels (`named`,
+    or glued to their values), a repeat's `list`, what follows the code (`after`), and its labels, the longest first
+    (a glued value is found by the longest label its text starts with)."""
+    labels = [item.label for item in m.fields if not (isinstance(item, TextField) and item.address)]
+    after = layout.separator if layout.after_code is None else layout.after_code
+    if layout.glued and m.code in labels:  # the value labelled with the code follows it (LSS's `D1800`)
+        after = ""
+    return {
+        "id": ids.setdefault(layout, len(ids) + 1),
+        "start": layout.start,
+        "ending": layout.end,
+        "separator": layout.separator,
+        "named": layout.named,
+        "glued": layout.glued,
+        "list": layout.list,
+        "after": after,
+        "labels": sorted(labels, key=len, reverse=True),
+        "labelled": {label: True for label in labels},
+    }
 
 
 def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
     refuse_text_frames(text, WIRESHARK_TAKES)
     messages: dict[str, dict[str, Any]] = {}
     alone: list[TextMessage] = []  # the messages found by their own code, the longest code first
+    enclosed: dict[TextLayout, dict[str, Any]] = {}  # the own texts with a start, each once, in message order
+    layout_ids: dict[TextLayout, int] = {}
     for m in text.messages:
         fields = [
-            {"name": item.name, "count": item.count, "max": item.max_count, "fields": [_field(f) for f in item.fields]}
+            {
+                "name": item.name,
+                "count": item.count,
+                "max": item.max_count,
+                "label": item.label,
+                "fields": [_field(f) for f in item.fields],
+            }
             if isinstance(item, TextRepeat)
             else _field(item)
             for item in m.fields
@@ -39,10 +70,12 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
             "fields": fields,
             "bare": m.values_only or None,  # read only right after its request (the last one before it in the capture)
         }
-        if m.layout is not None:  # found by its own code (common/text_frames.py found_by_code: nothing else)
-            after = m.layout.separator if m.layout.after_code is None else m.layout.after_code
-            entry["layout"] = {"after": after, "separator": m.layout.separator, "ending": m.layout.end}
-            alone.append(m)
+        if m.layout is not None:  # its own text: inside its start and end, or found by its code (without a start)
+            entry["layout"] = _layout(m, m.layout, layout_ids)
+            if m.layout.start:
+                enclosed.setdefault(m.layout, entry["layout"])
+            else:
+                alone.append(m)
         messages.setdefault(m.code, {})[m.direction.value] = entry
     for by_direction in messages.values():
         if len(by_direction) == 1:  # the code says the direction (runtime/text.py TextFraming.sentence)
@@ -75,6 +108,7 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
         "required": text.required,
         "checksum": checksum,
         "messages": messages,
+        "layouts": list(enclosed.values()),
         "alone": [{"code": m.code, "direction": m.direction.value} for m in sorted(alone, key=lambda m: -len(m.code))],
     }
     return render(

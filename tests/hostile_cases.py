@@ -892,6 +892,13 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("errata/doc003_crc_init/check/examples", ["nope"]),
         "errata.doc003_crc_init.check.examples: unknown example 'nope'",
     ),
+    (  # found by `make stress` (tests/test_spec_fuzz.py): the reference crashed formatting None as hex
+        "erratum checksum claimed null",
+        "fashionstar",
+        put("errata/ping_response_checksum_prose/check/claimed", None),
+        "errata.ping_response_checksum_prose.check.claimed: expected the value the document prints, a number or "
+        "text; got None",
+    ),
     # --- names: reserved, generated, colliding after case-folding ----------------------------------------------------
     (
         "field named self",

@@ -180,6 +180,12 @@ class Examples(Pass):
             )
         if kind == "checksum_value" and ("claimed" not in check or "actual" not in check):
             self.error(check_path, "a checksum_value check needs `claimed:` and `actual:`")
+        elif kind == "checksum_value" and (
+            not isinstance(claimed := check["claimed"], int | str) or isinstance(claimed, bool) or claimed == ""
+        ):  # (`actual` is an integer by the grammar; `claimed` any value: what the document prints, a number or words)
+            self.error(
+                (*check_path, "claimed"), f"expected the value the document prints, a number or text; got {claimed!r}"
+            )
         if kind == "crc_parameters" and not isinstance(check.get("claimed"), dict):
             self.error(check_path, "a crc_parameters check needs `claimed:` with the claimed parameters")
         return Erratum(

@@ -160,7 +160,7 @@ def test_empty_fields_are_none_and_absent_trailing_fields_too() -> None:
 @pytest.mark.parametrize(
     ("text", "reason"),
     [
-        ("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*48", "checksum 48 does not match"),
+        ("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*48", "bad checksum: the frame has 48"),
         ("$GPGGA,123519,48x7.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,", "GGA: latitude = '48x7.038' is not ddmm"),
         ("$GPGGA,123519,4867.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,", "GGA: latitude = '4867.038' is not ddmm"),
         ("$GPRMC,225446,X,4916.45,N,12311.12,W,000.5,054.7,191194,020.3,E", "RMC: status = 'X' is not one of A, V"),

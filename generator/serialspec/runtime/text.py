@@ -424,12 +424,12 @@ class TextFraming:
             if not 1 <= len(written) <= 3 or any(c not in _DIGITS for c in written):
                 raise ChecksumError(f"checksum {shown(written)} is not a decimal number of 1 to 3 digits")
             if int(written) != computed:
-                raise ChecksumError(f"checksum {written} does not match the frame's {computed}")
+                raise ChecksumError(f"bad checksum: the frame has {written}, its text gives {computed}")
             return covered
         if len(written) != self.digits or not written or any(c not in _HEX_DIGITS for c in written):
             raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
         if int(written, 16) != computed:
-            raise ChecksumError(f"checksum {written} does not match the frame's {computed:0{self.digits}X}")
+            raise ChecksumError(f"bad checksum: the frame has {written}, its text gives {computed:0{self.digits}X}")
         return covered
 
     # --- encoding --------------------------------------------------------------------------------------------------

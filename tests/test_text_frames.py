@@ -170,6 +170,8 @@ def test_empty_fields_are_none_and_absent_trailing_fields_too() -> None:
         ("$GPVTG,054.7,T,034.4,M,0x5.5,N,010.2,K", "VTG: speed_knots = '0x5.5' is not a decimal"),
         ("GPVTG,054.7,T,034.4,M,005.5,N,010.2,K", "does not start with '$'"),
         ("$GPVTG,054.7,T*4", "checksum '4' is not 2 hex digits"),
+        # a terminal's LF where the spec says CR LF: the error names the protocol's line ending
+        ("$GPVTG,054.7,T*4A\n", "is not 2 hex digits (a line ending? this protocol's lines end with '\\r\\n'"),
     ],
 )
 def test_bad_frames_get_one_line_reasons(text: str, reason: str) -> None:

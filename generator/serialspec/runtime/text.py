@@ -422,15 +422,24 @@ class TextFraming:
         computed = self.checksum(covered.encode("ascii"))
         if self.decimal:
             if not 1 <= len(written) <= 3 or any(c not in _DIGITS for c in written):
-                raise ChecksumError(f"checksum {shown(written)} is not a decimal number of 1 to 3 digits")
+                hint = self._line_end(written)
+                raise ChecksumError(f"checksum {shown(written)} is not a decimal number of 1 to 3 digits{hint}")
             if int(written) != computed:
                 raise ChecksumError(f"bad checksum: the frame has {written}, its text gives {computed}")
             return covered
         if len(written) != self.digits or not written or any(c not in _HEX_DIGITS for c in written):
-            raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
+            raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits{self._line_end(written)}")
         if int(written, 16) != computed:
             raise ChecksumError(f"bad checksum: the frame has {written}, its text gives {computed:0{self.digits}X}")
         return covered
+
+    def _line_end(self, text: str) -> str:
+        """Where `text` (after the checksum's marker) ends with CR or LF that is not the protocol's line ending (a
+        device's CR LF where the spec says CR, a terminal's LF): a hint naming the spec's; "" otherwise."""
+        if not text.endswith(("\r", "\n")):
+            return ""
+        ends = " or ".join(repr(e) for e in dict.fromkeys((self.end, self.response_end)) if e)
+        return f" (a line ending? this protocol's lines end with {ends}, `framing.end`)"
 
     # --- encoding --------------------------------------------------------------------------------------------------
 

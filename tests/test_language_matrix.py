@@ -1991,9 +1991,10 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         assert package.FRAMING.decode(b"#AEV;;;0a3f;-FA" + hexed[15:]).values["lx"] == -250
 
 
-def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output() -> None:
+def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output(tmp_path: Path) -> None:
     """`end: {request: ..., response: ...}` and a response's `text: {code: ...}` of several words (an ELM327's `010C`
-    answered `41 0C 1A F8 ` and CR CR `>`): C and Wireshark refuse each in one line; the reference says both; each
+    answered `41 0C 1A F8 ` and CR CR `>`): Wireshark refuses each in one line, the C the reply code (its line
+    endings by direction compile; tests/test_c_text.py holds them to Python); the reference says both; each
     direction ends with its own; the reply is found by its own code, the simulator answers with it and the codec
     pairs it with its request; random messages round trip, all in one stream of both directions read byte by byte;
     misuse (and of `base`, `case`) refused one line each."""
@@ -2001,7 +2002,21 @@ def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["end"] = {"request": "\n", "response": "\n\n>"}
     case["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
-    files = python_and_markdown(case, r"^a line ending of its own for each direction \(`end: \{request: \.\.\.")
+    files = python_and_markdown(
+        case,
+        r"^(a line ending of its own for each direction \(`end: \{request: \.\.\.|a reply under a code of its own)",
+    )
+    with pytest.raises(Unsupported, match=r"^a line ending of its own for each direction \(`end: \{request: "):
+        next(e for e in emitters() if e.name == "wireshark").files(
+            resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
+        )
+    ends_only = copy.deepcopy(case)
+    del ends_only["commands"]["dial"]["response"]["text"]
+    c_files = next(e for e in emitters() if e.name == "c").files(
+        resolve(load_text(yaml.safe_dump(ends_only, sort_keys=False), "x.yaml"))
+    )
+    text_c_compiles(c_files, tmp_path)
+    assert "matrix_text__response_end[] = {0x0Au, 0x0Au, 0x3Eu, 0x00u}" in c_files["matrix_text/matrix_text.c"]
     docs = files["docs/matrix_text.md"]
     assert "| end | LF (requests), LF LF > (responses) |" in docs
     assert "`DialResponse`, a response, under a code of its own (its request's is `DL`)" in docs

@@ -22,13 +22,17 @@
 #define NMEA0183__REQUIRED 0        /* a frame without one is refused */
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
 #define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
-#define NMEA0183__LIMIT 84u /* the parser drops a line longer than this without its line ending */
+/* the parser drops a line longer than this without its line ending */
+#define NMEA0183__LIMIT(dir) (82u + NMEA0183__END_LEN(dir))
 #define NMEA0183__REPLY(p) NMEA0183_KIND_NONE
 #define NMEA0183__ANSWERED(p, out) ((void)0)
 #define NMEA0183__INIT_REPLY(p) ((void)0)
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_ENCODE || NMEA0183_ENABLE_PARSER
 static const uint8_t nmea0183__end[] = {0x0Du, 0x0Au, 0x00u}; /* '\r\n', the line ending */
+#define NMEA0183__END(dir) nmea0183__end
+#define NMEA0183__END_LEN(dir) (sizeof(nmea0183__end) - 1u)
 #endif
+#define NMEA0183__OTHER(dir) ((dir) == NMEA0183_REQUEST ? NMEA0183_RESPONSE : NMEA0183_REQUEST)
 
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_PARSER
 /* 1 when a[0..n) and b[0..n) hold the same bytes */
@@ -478,13 +482,17 @@ static int nmea0183__hex_value(uint8_t c)
  * separator before the marker, it is no part of the fields. */
 static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
-    size_t i, end = len, stop;
+    size_t i, end = len, stop, ascii, own = NMEA0183__END_LEN(dir), other = NMEA0183__END_LEN(NMEA0183__OTHER(dir));
     *unchecked = 0;
     (void)dir;
-    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
-        end = len - (sizeof(nmea0183__end) - 1u);
+    if (len >= own && nmea0183__same(f + len - own, NMEA0183__END(dir), own)) {
+        end = len - own; /* the direction's line ending */
     }
-    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
+    ascii = end; /* before the longest line ending of either direction the frame ends with */
+    if (len >= other && other > len - end && nmea0183__same(f + len - other, NMEA0183__END(NMEA0183__OTHER(dir)), other)) {
+        ascii = len - other;
+    }
+    for (i = 0u; i < ascii; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
         }
@@ -561,10 +569,11 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[NMEA0183__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated)
+static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated, nmea0183_direction_t dir)
 {
     size_t k;
     (void)separated;
+    (void)dir;
 #if NMEA0183__S
     o->b[0] = NMEA0183__START;
 #endif
@@ -583,8 +592,8 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
         }
     }
 #endif
-    for (k = 0u; k + 1u < sizeof(nmea0183__end); k++) {
-        nmea0183__put(o, nmea0183__end[k]);
+    for (k = 0u; k < NMEA0183__END_LEN(dir); k++) {
+        nmea0183__put(o, NMEA0183__END(dir)[k]);
     }
     if (o->full) {
         return NMEA0183_E_BUFFER;
@@ -1907,12 +1916,13 @@ static size_t nmea0183__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
     return from;
 }
 
-/* Where the line ending is in b[from..n), n if nowhere. */
-static size_t nmea0183__find_end(const uint8_t *b, size_t from, size_t n)
+/* Where the line ending of `dir` is in b[from..n), n if nowhere. */
+static size_t nmea0183__find_end(const uint8_t *b, size_t from, size_t n, nmea0183_direction_t dir)
 {
-    size_t k = sizeof(nmea0183__end) - 1u;
+    size_t k = NMEA0183__END_LEN(dir);
+    (void)dir;
     for (; from + k <= n; from++) {
-        if (nmea0183__same(b + from, nmea0183__end, k)) {
+        if (nmea0183__same(b + from, NMEA0183__END(dir), k)) {
             return from;
         }
     }
@@ -1932,8 +1942,8 @@ static void nmea0183__drop(nmea0183_parser_t *p, size_t k)
  * than the spec's max_length, is dropped (counted in errors), as is one that does not decode. */
 static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *out)
 {
-    const size_t limit = NMEA0183__LIMIT, k = sizeof(nmea0183__end) - 1u;
-    if (p->n < NMEA0183__LIMIT + 1u) {
+    const size_t limit = NMEA0183__LIMIT(p->dir), k = NMEA0183__END_LEN(p->dir);
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
     for (;;) {
@@ -1943,7 +1953,7 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
             return 0;
         }
         nmea0183__drop(p, start);
-        end = nmea0183__find_end(p->buf, 1u, p->n);
+        end = nmea0183__find_end(p->buf, 1u, p->n, p->dir);
         restart = nmea0183__find(p->buf, 1u, p->n, NMEA0183__START);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
@@ -2054,6 +2064,21 @@ void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
 #endif
 
 #if NMEA0183_ENABLE_ENCODE
+/* The direction of a message of `kind`. */
+static nmea0183_direction_t nmea0183__direction(nmea0183_kind_t kind)
+{
+    switch (kind) {
+    case NMEA0183_GGA_RESPONSE:
+    case NMEA0183_RMC_RESPONSE:
+    case NMEA0183_VTG_RESPONSE:
+    case NMEA0183_GSA_RESPONSE:
+    case NMEA0183_GSV_RESPONSE:
+        return NMEA0183_RESPONSE;
+    default:
+        return NMEA0183_REQUEST;
+    }
+}
+
 int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {
     nmea0183__out_t o;
@@ -2088,7 +2113,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
         }
     }
 
-    return nmea0183__frame(&o, len, msg->unchecked, 0);
+    return nmea0183__frame(&o, len, msg->unchecked, 0, nmea0183__direction(msg->kind));
 }
 #endif
 

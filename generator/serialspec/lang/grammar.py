@@ -1537,8 +1537,9 @@ FRAMING = Obj(
             "text: the line ending that closes every frame. A mapping gives each direction its own (an ELM327 "
             'OBD-II adapter: `end: {request: "\\r", response: "\\r\\r>"}`, its reply ended by CR, a blank line '
             "and its `>` prompt): the stream parser of one direction waits for that direction's, and one reading "
-            "both takes the longest that ends a frame. The C target and the Wireshark dissector refuse line endings "
-            "that differ by direction, saying so.",
+            "both takes the longest that ends a frame. The C target writes and reads them (the parser of a "
+            "direction waits for its own); the Wireshark dissector refuses line endings that differ by direction, "
+            "saying so.",
             example="\r\n",
         ),
         "checksum": Obj(
@@ -1652,8 +1653,9 @@ FRAMING = Obj(
             "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
             "zero-padded to `width` digits, "
             "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
-            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it and the "
-            "Wireshark dissector refuse line endings by direction and reply codes of their own, one line each.",
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18) and line "
+            "endings by direction, and refuses reply codes of their own in one line; the Wireshark dissector "
+            "refuses both, one line each.",
         ),
     ),
 )

@@ -70,7 +70,8 @@ class TextC:
         refuse(text)
         self.protocol, self.text = protocol, text
         self.p, self.P = protocol.name, protocol.name.upper()
-        self.limit = text.max_length + len(text.end)
+        # the longest frame the parser holds: max_length and the longer line ending (each direction may have its own)
+        self.limit = text.max_length + max(len(text.end), len(text.response_end))
         self.bare_macros = ""  # replies of values alone: the macros that tell their kinds (bare_decode)
         self.calls: set[str] = set()  # the runtime's helpers the code written calls (text_runtime.used)
 
@@ -542,6 +543,46 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
 """
         return helpers, read, write, f"{p}__bare_reply(expect)"
 
+    def ends(self) -> str:
+        """The line endings as C: the requests' (`end`), the responses' where they have their own (ELM327's CR CR
+        `>`), and the macros that give a direction's."""
+        p, P, t = self.p, self.P, self.text
+
+        def array(name: str, ending: str, what: str) -> str:
+            bytes_ = ", ".join(_byte(c) for c in ending)
+            return f"static const uint8_t {p}__{name}[] = {{{bytes_}, 0x00u}}; /* {comment(repr(ending))}, {what} */\n"
+
+        if not t.response_end:
+            return (
+                array("end", t.end, "the line ending")
+                + f"#define {P}__END(dir) {p}__end\n#define {P}__END_LEN(dir) (sizeof({p}__end) - 1u)\n"
+            )
+        return (
+            array("end", t.end, "the requests' line ending")
+            + array("response_end", t.response_end, "the responses' line ending")
+            + f"#define {P}__END(dir) ((dir) == {P}_RESPONSE ? {p}__response_end : {p}__end)\n"
+            + f"#define {P}__END_LEN(dir) \\\n"
+            + f"    ((dir) == {P}_RESPONSE ? sizeof({p}__response_end) - 1u : sizeof({p}__end) - 1u)\n"
+        )
+
+    def direction(self) -> str:
+        """The direction of a message of each kind (encode writes its line ending)."""
+        p, P = self.p, self.P
+        cases = "\n".join(
+            f"    case {P}_{mid(m).upper()}:" for m in self.text.messages if m.direction.value == "response"
+        )
+        body = (
+            f"    switch (kind) {{\n{cases}\n        return {P}_RESPONSE;\n"
+            f"    default:\n        return {P}_REQUEST;\n    }}"
+            if cases
+            else f"    (void)kind;\n    return {P}_REQUEST;"
+        )
+        return f"""/* The direction of a message of `kind`. */
+static {p}_direction_t {p}__direction({p}_kind_t kind)
+{{
+{body}
+}}"""
+
     def bare_expect(self) -> str:
         """p_parser_expect where replies of values alone are read as the reply awaited (TextStreamParser.expect)."""
         p = self.p
@@ -555,8 +596,8 @@ void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
         bare = [m for m in t.messages if m.values_only]  # replies of values alone (`values_only`)
-        end = ", ".join(_byte(c) for c in t.end)
-        special_characters = sorted({t.start, t.separator, t.marker, *t.end} - {""})
+        ends = self.ends()
+        special_characters = sorted({t.start, t.separator, t.marker, *t.end, *t.response_end} - {""})
         checked = t.checksum is not None
         checksum, reflects = "", False
         if t.checksum is not None:
@@ -713,10 +754,11 @@ static int {p}__special(uint8_t c)
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
 #define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
-#define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
+/* the parser drops a line longer than this without its line ending */
+#define {P}__LIMIT(dir) ({t.max_length}u + {P}__END_LEN(dir))
 {reply_macros}#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
-static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
-#endif
+{ends}#endif
+#define {P}__OTHER(dir) ((dir) == {P}_REQUEST ? {P}_RESPONSE : {P}_REQUEST)
 
 #if {P}_ENABLE_DECODE || {P}_ENABLE_PARSER
 /* 1 when a[0..n) and b[0..n) hold the same bytes */
@@ -859,6 +901,8 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 
 {parser}
 #if {P}_ENABLE_ENCODE
+{self.direction()}
+
 int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {{
     {p}__out_t o;
@@ -883,7 +927,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
         }}
     }}
 {bare_write}
-    return {p}__frame(&o, len, msg->unchecked, {separated_kinds});
+    return {p}__frame(&o, len, msg->unchecked, {separated_kinds}, {p}__direction(msg->kind));
 }}
 #endif
 

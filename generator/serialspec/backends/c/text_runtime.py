@@ -707,13 +707,17 @@ static double pfx__angle_value(const pfx_angle_t *a)
  * separator before the marker, it is no part of the fields. */
 static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_t *body, size_t *n, int *unchecked)
 {
-    size_t i, end = len, stop;
+    size_t i, end = len, stop, ascii, own = PFX__END_LEN(dir), other = PFX__END_LEN(PFX__OTHER(dir));
     *unchecked = 0;
     (void)dir;
-    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
-        end = len - (sizeof(pfx__end) - 1u);
+    if (len >= own && pfx__same(f + len - own, PFX__END(dir), own)) {
+        end = len - own; /* the direction's line ending */
     }
-    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
+    ascii = end; /* before the longest line ending of either direction the frame ends with */
+    if (len >= other && other > len - end && pfx__same(f + len - other, PFX__END(PFX__OTHER(dir)), other)) {
+        ascii = len - other;
+    }
+    for (i = 0u; i < ascii; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
         }
@@ -817,10 +821,11 @@ static int pfx__trim(pfx__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[PFX__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated)
+static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated, pfx_direction_t dir)
 {
     size_t k;
     (void)separated;
+    (void)dir;
 #if PFX__S
     o->b[0] = PFX__START;
 #endif
@@ -866,8 +871,8 @@ DECIMAL_CHECKED_WRITE = Piece(
 )
 
 BEFORE_PARSER = Piece(
-    r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
-        pfx__put(o, pfx__end[k]);
+    r"""    for (k = 0u; k < PFX__END_LEN(dir); k++) {
+        pfx__put(o, PFX__END(dir)[k]);
     }
     if (o->full) {
         return PFX_E_BUFFER;
@@ -893,12 +898,13 @@ static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
     return from;
 }
 
-/* Where the line ending is in b[from..n), n if nowhere. */
-static size_t pfx__find_end(const uint8_t *b, size_t from, size_t n)
+/* Where the line ending of `dir` is in b[from..n), n if nowhere. */
+static size_t pfx__find_end(const uint8_t *b, size_t from, size_t n, pfx_direction_t dir)
 {
-    size_t k = sizeof(pfx__end) - 1u;
+    size_t k = PFX__END_LEN(dir);
+    (void)dir;
     for (; from + k <= n; from++) {
-        if (pfx__same(b + from, pfx__end, k)) {
+        if (pfx__same(b + from, PFX__END(dir), k)) {
             return from;
         }
     }
@@ -918,8 +924,8 @@ static void pfx__drop(pfx_parser_t *p, size_t k)
  * than the spec's max_length, is dropped (counted in errors), as is one that does not decode. */
 static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 {
-    const size_t limit = PFX__LIMIT, k = sizeof(pfx__end) - 1u;
-    if (p->n < PFX__LIMIT + 1u) {
+    const size_t limit = PFX__LIMIT(p->dir), k = PFX__END_LEN(p->dir);
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
     for (;;) {
@@ -929,7 +935,7 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
             return 0;
         }
         pfx__drop(p, start);
-        end = pfx__find_end(p->buf, 1u, p->n);
+        end = pfx__find_end(p->buf, 1u, p->n, p->dir);
         restart = pfx__find(p->buf, 1u, p->n, PFX__START);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
@@ -985,14 +991,14 @@ LINES_PUSH = Piece(
  * that does not decode is dropped. */
 static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 {
-    const size_t k = sizeof(pfx__end) - 1u;
+    const size_t k = PFX__END_LEN(p->dir), limit = PFX__LIMIT(p->dir);
     size_t from = 0u, i;
     int r;
-    if (p->n < PFX__LIMIT + 1u) {
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
-    if (p->n < k || !pfx__same(p->buf + p->n - k, pfx__end, k)) { /* byte by byte: an ending is at the tail */
-        if (p->n > PFX__LIMIT) {
+    if (p->n < k || !pfx__same(p->buf + p->n - k, PFX__END(p->dir), k)) { /* byte by byte: an ending is at the tail */
+        if (p->n > limit) {
             p->errors++;
             for (i = 0u; i + 1u < k; i++) { /* keep what may begin a line ending */
                 p->buf[i] = p->buf[p->n - (k - 1u) + i];

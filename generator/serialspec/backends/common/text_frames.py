@@ -9,21 +9,21 @@ from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
 # what of the list the C target generates (its Wireshark dissector does not yet)
-C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end"})
+C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends"})
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     """Unsupported naming the first text feature of the list the target does not generate; `takes`: the features of
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
-    with bytes above 0x7F)."""
+    with bytes above 0x7F, "ends": a line ending of its own for each direction)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
     if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
         raise Unsupported("a text field to the end of the line (`size: rest`)")
-    if text.response_end:
+    if text.response_end and "ends" not in takes:
         raise Unsupported("a line ending of its own for each direction (`end: {request: ..., response: ...}`)")
     if any(m.code != (text.request(m.key) or m).code for m in text.messages):
         raise Unsupported("a reply under a code of its own (`text: {code: ...}`)")

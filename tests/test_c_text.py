@@ -35,6 +35,27 @@ MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
 # a line ending of bytes above 0x7F (Nextion's FF FF FF) for requests, and one of their own for responses (an
 # ELM327's CR CR `>`, here LF LF `>`)
 MATRIX["framing"]["end"] = {"request": "\xff\xff\xff", "response": "\n\n>"}
+# messages in their own text found by their code alone: a reply under a code of its own of two words, a value glued to
+# its code beside a longer code it begins (LSS's `D1800`), and a separator and list of their own
+MATRIX["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
+MATRIX["commands"] |= {
+    "glued": {
+        "code": "GL",
+        "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
+    },
+    "longer": {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}},
+    "pairs": {
+        "code": "PR",
+        "response": {
+            "unsolicited": True,
+            "text": {"separator": "=", "list": ":"},
+            "fields": {
+                "vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}},
+                "more": {"type": "repeat", "max_count": 2, "fields": {"w": "integer", "t": "text"}},
+            },
+        },
+    },
+}
 # frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), requests ended by
 # CR LF, responses by CR CR `>` (an ELM327's); an
 # optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`); a reply of
@@ -50,6 +71,29 @@ LINES["framing"]["checksum"] = {
     "separated": ["request"],
 }
 LINES["commands"]["dial"]["response"]["values_only"] = True  # ODrive's `r vbus_voltage` answered `24.1`
+# replies under codes of their own: an AT modem's `+CSQ: 20,99` and an ELM327's `41 0C 1A F8 ` (here `;` between words)
+LINES["commands"] |= {
+    "signal": {
+        "code": "SQ",
+        "request": {"fields": {}},
+        "response": {
+            "text": {"code": "+SQ:", "after_code": " "},
+            "fields": {"rssi": {"type": "integer", "range": [0, 99]}, "ber": {"type": "integer", "range": [0, 99]}},
+        },
+    },
+    "rpm": {
+        "code": "RPM",
+        "request": {"fields": {}},
+        "response": {
+            "text": {"code": "41;0C", "end": " "},
+            "fields": {
+                "a": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                "b": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                "note": "text",
+            },
+        },
+    },
+}
 # the every-kind case with its own ending (CR LF), for the Wireshark dissector, which refuses FF FF FF
 # (tests/test_wireshark_text.py)
 WIRESHARK = copy.deepcopy(TEXT_CASE) | {"protocol": "wireshark_text_matrix"}

@@ -105,12 +105,15 @@ static int nmea0183__digit(uint8_t c)
 }
 #endif
 
-/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
+/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last; sep and
+ * list end a field (the framing's separator, or a message's own separator and list character). */
 typedef struct {
     const uint8_t *b;
     size_t n;
     size_t pos;
     int more;
+    uint8_t sep;
+    uint8_t list;
 } nmea0183__cursor_t;
 
 #if NMEA0183_ENABLE_DECODE
@@ -123,7 +126,7 @@ static void nmea0183__next(nmea0183__cursor_t *c, size_t *start, size_t *len)
         *len = 0u;
         return;
     }
-    while (i < c->n && c->b[i] != NMEA0183__SEPARATOR) {
+    while (i < c->n && c->b[i] != c->sep && c->b[i] != c->list) {
         i++;
     }
     *start = c->pos;
@@ -1140,8 +1143,8 @@ static nmea0183_kind_t nmea0183__lookup(const uint8_t *code, size_t n, nmea0183_
     return NMEA0183_KIND_NONE;
 }
 
-/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's first field is
- * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
 static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
                        nmea0183_msg_t *out)
 {
@@ -1181,6 +1184,8 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+    c.sep = NMEA0183__SEPARATOR;
+    c.list = NMEA0183__SEPARATOR;
     (void)reply;
     if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
         return NMEA0183_E_UNKNOWN;
@@ -1233,10 +1238,14 @@ int nmea0183_decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, 
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gga_response(const nmea0183_gga_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_utc && (!nmea0183__time_ok(&m->utc))) {
             return NMEA0183_E_RANGE;
@@ -1407,10 +1416,14 @@ static int nmea0183__enc_gga_response(const nmea0183_gga_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_rmc_response(const nmea0183_rmc_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_utc && (!nmea0183__time_ok(&m->utc))) {
             return NMEA0183_E_RANGE;
@@ -1555,10 +1568,14 @@ static int nmea0183__enc_rmc_response(const nmea0183_rmc_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_vtg_response(const nmea0183_vtg_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_course_true && (m->course_true.scale > 18u)) {
             return NMEA0183_E_RANGE;
@@ -1670,10 +1687,14 @@ static int nmea0183__enc_vtg_response(const nmea0183_vtg_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gsa_response(const nmea0183_gsa_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_selection && (m->selection != 'M' && m->selection != 'A')) {
             return NMEA0183_E_RANGE;
@@ -1756,10 +1777,14 @@ static int nmea0183__enc_gsa_response(const nmea0183_gsa_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_sentences && (nmea0183__compare(m->sentences, 0u, 1, 0u) < 0)) {
             return NMEA0183_E_RANGE;
@@ -2106,7 +2131,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
     if (r != NMEA0183_OK) {
         return r;
     }
-    if (msg->sent >= 0 && !o.full) { /* as many fields as the sentence had */
+    if (msg->sent >= 0 && !o.full && !(0)) { /* as many fields as the sentence had */
         r = nmea0183__trim(&o, (size_t)msg->sent);
         if (r != NMEA0183_OK) {
             return r;

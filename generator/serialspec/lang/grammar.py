@@ -724,8 +724,8 @@ TEXT_LAYOUT = Obj(
             'own (an ELM327 answers `010C` with `41 0C 1A F8`: `response: {text: {code: "41 0C"}}`; an AT modem '
             'answers `AT+CSQ` with `+CSQ: 20,99`: `text: {code: "+CSQ:", after_code: " "}`). It may hold '
             "the message's separator (several words); the message is found by it, the longest code that fits, and "
-            "clients and the simulator pair it with its request as usual. The C target and the Wireshark dissector "
-            "refuse it, saying so.",
+            "clients and the simulator pair it with its request as usual. The C target writes and reads it; the "
+            "Wireshark dissector refuses it, saying so.",
             example="41 0C",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
@@ -759,7 +759,8 @@ TEXT_LAYOUT = Obj(
     },
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
-    "checksum and line end stay the framing's.",
+    "checksum and line end stay the framing's. The C target takes a message found by its code (no `start`) "
+    "whose fields have no labels; it refuses a `start` or labels, and the Wireshark dissector any `text:`, saying so.",
 )
 
 MESSAGE = Obj(
@@ -1653,9 +1654,8 @@ FRAMING = Obj(
             "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
             "zero-padded to `width` digits, "
             "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
-            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18) and line "
-            "endings by direction, and refuses reply codes of their own in one line; the Wireshark dissector "
-            "refuses both, one line each.",
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18), line endings "
+            "by direction and reply codes of their own; the Wireshark dissector refuses the last two, one line each.",
         ),
     ),
 )

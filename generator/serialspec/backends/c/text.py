@@ -370,8 +370,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
     return c->more ? {P}_E_LENGTH : {P}_OK; /* more fields than the message has */
 }}"""
 
-    def check(self, f: TextField, lv: str) -> str:
-        """The range checks of one field (encode refuses with P_E_RANGE before it writes)."""
+    def check(self, f: TextField, lv: str, own: str = "") -> str:
+        """The range checks of one field (encode refuses with P_E_RANGE before it writes); `own`: the characters of
+        the message's own layout, which its texts may not hold either."""
         P, n = self.P, ident(f.name)
         v = f"{lv}{n}"
         tests: list[str] = []
@@ -399,8 +400,12 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 if f.letters:
                     tests.append(" && ".join(f"{v} != '{_c_char(letter)}'" for _, letter in f.letters))
                 tests.append(f"!{self.call('carried')}({v})")
+                if own:
+                    tests.append(f"!{self.call('avoids')}(&{v}, 1u, {_c_string(own)})")
             case "text":
                 tests.append(f"{v}_len > {P}_TEXT_MAX || !{self.call('text_ok')}({v}, {v}_len)")
+                if own:
+                    tests.append(f"!{self.call('avoids')}({v}, {v}_len, {_c_string(own)})")
             case "time":
                 tests.append(f"!{self.call('time_ok')}(&{v})")
             case "date":
@@ -409,7 +414,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 assert_never(f.kind)
         return "\n".join(f"    if ({lv}has_{n} && ({t})) {{\n        return {P}_E_RANGE;\n    }}" for t in tests)
 
-    def write(self, f: TextField, lv: str) -> str:
+    def write(self, f: TextField, lv: str, part: str = "") -> str:
+        """The writing of one field after the framing's separator, or (`part`: the separator of a message's own
+        layout, as C) as a part of its layout, after that separator where a part comes before it."""
         n = ident(f.name)
         v = f"{lv}{n}"
         match f.kind:
@@ -431,38 +438,61 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 call = f"{self.call('put_date')}(o, &{v})"
             case _:
                 assert_never(f.kind)
-        return f"    {self.call('put')}(o, {self.P}__SEPARATOR);\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+        before = f"{self.call('part')}(o, &first, {part})" if part else f"{self.call('put')}(o, {self.P}__SEPARATOR)"
+        return f"    {before};\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
 
     def encoder(self, m: TextMessage) -> str:
         p, P = self.p, self.P
         checks: list[str] = []
         writes: list[str] = []
+        layout = m.layout
+        own, part, joined = "", "", ""
+        if layout is not None:  # its own separator (a repeat's values joined by `list`) and characters
+            own = "".join(sorted({layout.end, layout.separator, layout.list, layout.after_code or ""} - {""}))
+            part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
         for item in _items(m):
             if isinstance(item, TextField):
-                checks.append(self.check(item, "m->"))
-                writes.append(self.write(item, "m->"))
+                checks.append(self.check(item, "m->", own))
+                writes.append(self.write(item, "m->", part))
                 continue
             name = ident(item.name)
             groups = f"{item.count}u" if item.count else f"m->{name}_count"
             if not item.count:
                 checks.append(f"    if (m->{name}_count > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
-            inner = "\n".join(self.check(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            inner = "\n".join(self.check(f, f"m->{name}[g].", own) for f in item.fields).replace("\n", "\n    ")
             checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
-            inner = "\n".join(self.write(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            inner = "\n".join(
+                self.write(f, f"m->{name}[g].", (f"g == 0u ? {part} : {joined}" if k == 0 else joined) if part else "")
+                for k, f in enumerate(item.fields)
+            ).replace("\n", "\n    ")
             writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
         head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
+        written = "\n".join(writes)
+        if layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text
+            after = layout.separator if layout.after_code is None else layout.after_code
+            written = (
+                f"    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);\n    fields = o->n;\n{written}\n"
+                f"    if (o->n == fields) {{ /* no text after the code: the code alone */\n"
+                f"        o->n = code;\n    }}\n"
+                f"    {self.call('put_text')}(o, {_c_string(layout.end)}, {len(layout.end)}u);"
+            )
+            head += ", in its own layout"
         return f"""/* {head}: the range checks (when asked), then each
  * field after a separator, an absent one empty. */
 static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
 {{
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {{
 {chr(10).join(checks).replace(chr(10), chr(10) + "    ") if checks else ""}
     }}
-{chr(10).join(writes)}
+{written}
     return {P}_OK;
 }}"""
 
@@ -542,6 +572,72 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
     }}
 """
         return helpers, read, write, f"{p}__bare_reply(expect)"
+
+    def alone_decode(self) -> tuple[str, str, str]:
+        """Messages in their own layout, found by their code alone (an ELM327's reply `41 0C 1A F8 `, an AT modem's
+        `+CSQ: 20,99`; runtime/text.py TextFraming._decode_alone), tried where the frame's first field is no code of
+        a message of `dir` in the framing's own text: the helper before the decoder, the decoder's reading of one,
+        and the test of the kinds whose frames are written in their own layout (encode ignores `sent` there)."""
+        p, P, t = self.p, self.P, self.text
+        alone = sorted((m for m in t.messages if m.layout is not None), key=lambda m: -len(m.code))
+        own_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in alone) or "0"
+        if not alone:
+            return "", "", own_kinds
+        plain = [m for m in t.messages if m.layout is None and not m.values_only]
+        cases = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n        return dir == {P}_{m.direction.name};" for m in plain
+        )
+        body = f"    switch (kind) {{\n{cases}\n    default:\n        return 0;\n    }}" if plain else "    return 0;"
+        helpers = f"""/* 1 when `kind` (a frame's first field's) is a message of `dir` in the framing's text. */
+static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
+{{
+    (void)kind;
+    (void)dir;
+{body}
+}}
+
+"""
+        skip = f"({t.talker}u < n ? {t.talker}u : n)" if t.talker else "0u"
+        tries: list[str] = []
+        for m in alone:
+            layout = m.layout
+            assert layout is not None
+            after = layout.separator if layout.after_code is None else layout.after_code
+            call = (
+                f"{self.call('alone')}(t, tn, {_c_string(m.code)}, {len(m.code)}u, {_c_string(after)}, {len(after)}u, "
+                f"{_c_string(layout.end)}, {len(layout.end)}u, &at, &inner)"
+            )
+            tries.append(
+                f"        {'if' if not tries else '} else if'} (dir == {P}_{m.direction.name} &&\n"
+                f"            {call}) {{\n"
+                f"            kind = {P}_{mid(m).upper()};\n"
+                f"            c.sep = {_byte(layout.separator)};\n"
+                f"            c.list = {_byte(layout.list or layout.separator)};"
+            )
+        read = f"""    if (!{p}__plain(kind, dir)) {{ /* found by its code alone, of `dir`: longest code first */
+        const uint8_t *t = frame + body + {skip};
+        size_t tn = n - {skip}, at = 0u, inner = 0u;
+        int found = 1;
+{chr(10).join(tries)}
+        }} else {{
+            found = 0;
+        }}
+        if (found) {{ /* its fields, between its own separators */
+            c.b = t + at;
+            c.n = inner;
+            c.pos = 0u;
+            c.more = inner > 0u;
+            seps = inner > 0u ? 1u : 0u;
+            for (i = 0u; i < inner; i++) {{
+                if (c.b[i] == c.sep || c.b[i] == c.list) {{
+                    seps++;
+                }}
+            }}
+            out->sent = -1;
+        }}
+    }}
+"""
+        return helpers, read, own_kinds
 
     def ends(self) -> str:
         """The line endings as C: the requests' (`end`), the responses' where they have their own (ELM327's CR CR
@@ -628,6 +724,7 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 }}
 """
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
+        alone_helpers, alone_read, own_kinds = self.alone_decode()
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}
         for m in t.messages:
@@ -800,8 +897,8 @@ static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir
     return {P}_KIND_NONE;
 }}
 
-{bare_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's first field is
- * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
+{bare_helpers}{alone_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
 static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
                        {p}_msg_t *out)
 {{
@@ -837,7 +934,9 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
-{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+    c.sep = {P}__SEPARATOR;
+    c.list = {P}__SEPARATOR;
+{alone_read}{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
         return {P}_E_UNKNOWN;
     }}
     out->unchecked = unchecked != 0;
@@ -920,7 +1019,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     if (r != {P}_OK) {{
         return r;
     }}
-    if (msg->sent >= 0 && !o.full) {{ /* as many fields as the sentence had */
+    if (msg->sent >= 0 && !o.full && !({own_kinds})) {{ /* as many fields as the sentence had */
         r = {p}__trim(&o, (size_t)msg->sent);
         if (r != {P}_OK) {{
             return r;
@@ -952,6 +1051,12 @@ const char *{p}_result_name(int result)
 }}
 """
         return text
+
+
+def _c_string(text: str) -> str:
+    """Any text as a C string literal: letters and digits as they are, every other character as an octal escape (no
+    trigraph, no escape that runs on)."""
+    return '"' + "".join(c if c.isascii() and c.isalnum() else f"\\{ord(c):03o}" for c in text) + '"'
 
 
 def _c_char(c: str) -> str:
@@ -1035,6 +1140,21 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
                 f'    {p}__j_str(&j, "]");'
             )
         body = "\n".join(parts)
+        if m.layout is not None:  # its own layout: the fields after the talker, code and what follows the code
+            layout = m.layout
+            after = layout.separator if layout.after_code is None else layout.after_code
+            body = (
+                (
+                    f"    for (c.pos = 0u; c.pos < {text.talker}u && msg->talker[c.pos] != '\\0'; c.pos++) {{\n    }}\n"
+                    if text.talker
+                    else "    c.pos = 0u;\n"
+                )
+                + f"    c.pos += {len(m.code) + len(after)}u;\n"
+                + (f"    c.n = len >= {len(layout.end)}u ? len - {len(layout.end)}u : 0u;\n" if layout.end else "")
+                + f"    c.pos = c.pos < c.n ? c.pos : c.n;\n"
+                f"    c.sep = {_byte(layout.separator)};\n    c.list = {_byte(layout.list or layout.separator)};\n"
+                + body
+            )
         cases.append(
             f"    case {P}_{mid(m).upper()}:\n"
             f'        {p}__j_str(&j, "{{\\"command\\":\\"{m.key}\\",\\"subcommand\\":null,\\"direction\\":'
@@ -1096,17 +1216,20 @@ static void {p}__j_text({p}__json_t *j, const uint8_t *t, size_t n)
     {p}__j_char(j, '"');
 }}
 
-/* The fields' texts one after another, as the frame has them after the address. */
+/* The fields' texts one after another, as the frame has them after the address, ended by sep or list (a message's
+ * own layout's). */
 typedef struct {{
     const uint8_t *b;
     size_t n;
     size_t pos;
+    uint8_t sep;
+    uint8_t list;
 }} {p}__jcur_t;
 
 static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
 {{
     size_t start = c->pos;
-    while (c->pos < c->n && c->b[c->pos] != {_byte(text.separator)}) {{
+    while (c->pos < c->n && c->b[c->pos] != c->sep && c->b[c->pos] != c->list) {{
         c->pos++;
     }}
     {p}__j_text(j, c->b + start, c->pos - start);
@@ -1142,6 +1265,8 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     c.b = body;
     c.n = len;
     c.pos = 0u;
+    c.sep = {_byte(text.separator)};
+    c.list = {_byte(text.separator)};
     while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the address: skipped */
         c.pos++;
     }}

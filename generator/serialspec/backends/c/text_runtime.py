@@ -82,12 +82,15 @@ HEAD = (
     Piece(
         r"""#endif
 
-/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
+/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last; sep and
+ * list end a field (the framing's separator, or a message's own separator and list character). */
 typedef struct {
     const uint8_t *b;
     size_t n;
     size_t pos;
     int more;
+    uint8_t sep;
+    uint8_t list;
 } pfx__cursor_t;
 
 #if PFX_ENABLE_DECODE
@@ -105,7 +108,7 @@ static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
         *len = 0u;
         return;
     }
-    while (i < c->n && c->b[i] != PFX__SEPARATOR) {
+    while (i < c->n && c->b[i] != c->sep && c->b[i] != c->list) {
         i++;
     }
     *start = c->pos;
@@ -116,6 +119,49 @@ static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
 
 """,
         "next",
+        (),
+    ),
+    Piece(
+        r"""/* A message found by its code alone (runtime/text.py TextFraming._decode_alone): 1 when t[0..n) starts with
+ * code[0..k) and the rest is empty or starts with after[0..a) and ends with end[0..e); its fields are then
+ * t[*at, *at + *len). */
+static int pfx__alone(const uint8_t *t, size_t n, const char *code, size_t k, const char *after, size_t a,
+                      const char *end, size_t e, size_t *at, size_t *len)
+{
+    size_t i;
+    if (n < k) {
+        return 0;
+    }
+    for (i = 0u; i < k; i++) {
+        if (t[i] != (uint8_t)code[i]) {
+            return 0;
+        }
+    }
+    if (n == k) {
+        *at = k;
+        *len = 0u;
+        return 1;
+    }
+    if (n - k < a || n - k < e) {
+        return 0;
+    }
+    for (i = 0u; i < a; i++) {
+        if (t[k + i] != (uint8_t)after[i]) {
+            return 0;
+        }
+    }
+    for (i = 0u; i < e; i++) {
+        if (t[n - e + i] != (uint8_t)end[i]) {
+            return 0;
+        }
+    }
+    *at = k + a;
+    *len = n - k >= a + e ? n - k - a - e : 0u;
+    return 1;
+}
+
+""",
+        "alone",
         (),
     ),
     Piece(
@@ -429,6 +475,20 @@ typedef struct {
         (),
     ),
     Piece(
+        r"""/* Between the parts of a message in its own layout: `c` before every part but the first. */
+static void pfx__part(pfx__out_t *o, int *first, uint8_t c)
+{
+    if (!*first) {
+        pfx__put(o, c);
+    }
+    *first = 0;
+}
+
+""",
+        "part",
+        ("put",),
+    ),
+    Piece(
         r"""/* v's decimal digits, at least `width` (zeros in front). */
 static void pfx__put_digits(pfx__out_t *o, uint64_t v, unsigned width)
 {
@@ -661,6 +721,25 @@ static int pfx__carried(char c)
 """,
         "text_ok",
         ("carried",),
+    ),
+    Piece(
+        r"""/* 1 when none of t[0..n) is one of a message's own characters `own` (its layout's). */
+static int pfx__avoids(const char *t, size_t n, const char *own)
+{
+    size_t i, k;
+    for (i = 0u; i < n; i++) {
+        for (k = 0u; own[k] != '\0'; k++) {
+            if (t[i] == own[k]) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+""",
+        "avoids",
+        (),
     ),
     Piece(
         r"""/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */

@@ -9,14 +9,15 @@ from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
 # what of the list the C target generates (its Wireshark dissector does not yet)
-C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends"})
+C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts"})
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     """Unsupported naming the first text feature of the list the target does not generate; `takes`: the features of
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
-    with bytes above 0x7F, "ends": a line ending of its own for each direction)."""
+    with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a
+    code of its own, "layouts": messages in their own text found by their code alone, without labels)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -25,10 +26,12 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a text field to the end of the line (`size: rest`)")
     if text.response_end and "ends" not in takes:
         raise Unsupported("a line ending of its own for each direction (`end: {request: ..., response: ...}`)")
-    if any(m.code != (text.request(m.key) or m).code for m in text.messages):
+    if any(m.code != (text.request(m.key) or m).code for m in text.messages) and "codes" not in takes:
         raise Unsupported("a reply under a code of its own (`text: {code: ...}`)")
-    if any(m.layout is not None for m in text.messages):
+    if any(m.layout is not None for m in text.messages) and "layouts" not in takes:
         raise Unsupported("a message's own text layout (`text:`)")
+    if any(m.layout is not None and (m.layout.start or m.layout.labelled) for m in text.messages):
+        raise Unsupported("a message's own text with a start or labels (`text: {start: ...}`, `text: {named: ...}`)")
     # (a target that reads each line alone: a line of values names no message)
     if any(m.values_only for m in text.messages) and "values_only" not in takes:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")

@@ -71,6 +71,17 @@ LINES["framing"]["checksum"] = {
     "separated": ["request"],
 }
 LINES["commands"]["dial"]["response"]["values_only"] = True  # ODrive's `r vbus_voltage` answered `24.1`
+# a text to the end of the line (`size: rest`: Marlin's `Error:checksum mismatch, Last Line: 122`), separators and all,
+# in a plain message (both cases) and in one found by its code (`ER=...`)
+NOTE = {
+    "code": "NT",
+    "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+}
+MATRIX["commands"]["note"] = LINES["commands"]["note"] = NOTE
+MATRIX["commands"]["error"] = {
+    "code": "ER",
+    "response": {"unsolicited": True, "text": {"after_code": "="}, "fields": {"msg": {"type": "text", "size": "rest"}}},
+}
 # replies under codes of their own: an AT modem's `+CSQ: 20,99` and an ELM327's `41 0C 1A F8 ` (here `;` between words)
 LINES["commands"] |= {
     "signal": {
@@ -289,11 +300,21 @@ def frames(b: Built, direction: str) -> st.SearchStrategy[bytes]:
             return None
 
     choices = [
-        st.tuples(sentence_values(s), st.sampled_from(talkers)).map(lambda x, s=s: encoded(s, *x))
+        st.tuples(values_of(s), st.sampled_from(talkers)).map(lambda x, s=s: encoded(s, *x))
         for s in b.framing.sentences
         if s.direction == direction
     ]
     return st.one_of(choices).filter(lambda frame: frame is not None)  # type: ignore[arg-type]
+
+
+def values_of(sentence: TextSentence) -> st.SearchStrategy[dict[str, Any]]:
+    """A message's values (test_text_frames.sentence_values), a text to the end of the line holding the separator
+    and a message's own characters too."""
+    rest = [f for f in sentence.fields if isinstance(f, TextField) and f.rest]
+    if not rest:
+        return sentence_values(sentence)
+    text = st.one_of(st.none(), st.text(st.sampled_from("ab =;:1"), min_size=1))
+    return st.tuples(sentence_values(sentence), text).map(lambda x: {**x[0], rest[0].name: x[1]})
 
 
 def directions(b: Built) -> list[str]:

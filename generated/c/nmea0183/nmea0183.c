@@ -320,7 +320,8 @@ typedef struct {
     uint8_t *b;
     size_t cap;
     size_t n;
-    int full; /* something did not fit */
+    int full;    /* something did not fit */
+    size_t rest; /* where a text to the end of the line begins (0: none; the separators in it are its own) */
 } nmea0183__out_t;
 
 static void nmea0183__put(nmea0183__out_t *o, uint8_t c)
@@ -546,18 +547,19 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t 
 
 #if NMEA0183_ENABLE_ENCODE
 /* Exactly `sent` fields after the address (o->b[NMEA0183__S..n): the address, then each field after a separator): the fields
- * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. */
+ * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. A text to the end of the line
+ * (from o->rest on) is one field, the separators in it its own. */
 static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 {
-    size_t i, k, fields = 0u;
-    for (i = NMEA0183__S; i < o->n; i++) {
+    size_t i, k, fields = 0u, rest = o->rest > 0u ? o->rest : o->n;
+    for (i = NMEA0183__S; i < rest; i++) {
         if (o->b[i] == NMEA0183__SEPARATOR && ++fields > sent) {
             break;
         }
     }
     if (fields > sent) {
         for (k = i; k < o->n; k++) {
-            if (o->b[k] != NMEA0183__SEPARATOR) {
+            if (o->b[k] != NMEA0183__SEPARATOR || k >= rest) {
                 return NMEA0183_E_LENGTH; /* a field after the last one sent has a value */
             }
         }
@@ -1923,6 +1925,7 @@ int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, si
     o.cap = cap;
     o.n = 0u;
     o.full = 0;
+    o.rest = 0u;
     r = nmea0183__body(msg, &o, 0);
     if (r == NMEA0183_OK && o.full) {
         r = NMEA0183_E_BUFFER;
@@ -2127,6 +2130,7 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
     o.cap = cap;
     o.n = NMEA0183__S;
     o.full = 0;
+    o.rest = 0u;
     r = nmea0183__body(msg, &o, 1);
     if (r != NMEA0183_OK) {
         return r;

@@ -542,7 +542,8 @@ _FIELD_LONG: dict[str, Shape] = {
         "earlier integer fields, which stay in the message (`length - 2`: see `count`); array: the earlier "
         "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
         "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
-        "mismatch, Last Line: 122` as one text); the C target and the Wireshark dissector refuse it, saying so.",
+        "mismatch, Last Line: 122` as one text); the C target takes it, the Wireshark dissector refuses it, "
+        "saying so.",
     ),
     "count": OneOf(
         (Int(), Str()),

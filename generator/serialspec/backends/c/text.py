@@ -321,7 +321,7 @@ const char *{p}_result_name(int result);
         if f.letters:
             allowed = " && ".join(f"{target} != '{_c_char(letter)}'" for _, letter in f.letters)
             letters = f"\n        if (r == {P}_OK && {allowed}) {{\n            r = {P}_E_CONTENT;\n        }}"
-        return f"""    {self.call("next")}(c, &s, &len);
+        return f"""    {self.call("rest" if f.rest else "next")}(c, &s, &len);
     {lv}has_{n} = len > 0u;
     if (len > 0u) {{
         r = {call};{letters}
@@ -370,7 +370,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
     return c->more ? {P}_E_LENGTH : {P}_OK; /* more fields than the message has */
 }}"""
 
-    def check(self, f: TextField, lv: str, own: str = "") -> str:
+    def check(self, f: TextField, lv: str, own: str = "", rest_own: str = "") -> str:
         """The range checks of one field (encode refuses with P_E_RANGE before it writes); `own`: the characters of
         the message's own layout, which its texts may not hold either."""
         P, n = self.P, ident(f.name)
@@ -403,9 +403,11 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 if own:
                     tests.append(f"!{self.call('avoids')}(&{v}, 1u, {_c_string(own)})")
             case "text":
-                tests.append(f"{v}_len > {P}_TEXT_MAX || !{self.call('text_ok')}({v}, {v}_len)")
-                if own:
-                    tests.append(f"!{self.call('avoids')}({v}, {v}_len, {_c_string(own)})")
+                ok = self.call("rest_ok" if f.rest else "text_ok")
+                tests.append(f"{v}_len > {P}_TEXT_MAX || !{ok}({v}, {v}_len)")
+                mine = rest_own if f.rest else own  # a text to the end of the line may hold the separators
+                if mine:
+                    tests.append(f"!{self.call('avoids')}({v}, {v}_len, {_c_string(mine)})")
             case "time":
                 tests.append(f"!{self.call('time_ok')}(&{v})")
             case "date":
@@ -439,6 +441,8 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             case _:
                 assert_never(f.kind)
         before = f"{self.call('part')}(o, &first, {part})" if part else f"{self.call('put')}(o, {self.P}__SEPARATOR)"
+        if f.rest and not part:  # the separators in it are its own (p__trim)
+            before += ";\n    o->rest = o->n"
         return f"    {before};\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
 
     def encoder(self, m: TextMessage) -> str:
@@ -450,9 +454,14 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         if layout is not None:  # its own separator (a repeat's values joined by `list`) and characters
             own = "".join(sorted({layout.end, layout.separator, layout.list, layout.after_code or ""} - {""}))
             part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
+        rest_own = (
+            "".join(sorted(set(own) - {layout.separator, layout.after_code or "", self.text.separator}))
+            if layout
+            else ""
+        )
         for item in _items(m):
             if isinstance(item, TextField):
-                checks.append(self.check(item, "m->", own))
+                checks.append(self.check(item, "m->", own, rest_own))
                 writes.append(self.write(item, "m->", part))
                 continue
             name = ident(item.name)
@@ -740,7 +749,14 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             lookups.append(f"    if ({p}__is(code, n, {c_text(name)})) {{\n        return {pick};\n    }}")
         dec_cases = "\n".join(
             f"    case {P}_{mid(m).upper()}:\n        memset(&out->u.{mid(m)}, 0, sizeof(out->u.{mid(m)}));\n"
-            f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n        break;"
+            f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n"
+            + (
+                f"        if (out->sent > {len(m.fields)}) {{ /* a text to the end of the line is one field */\n"
+                f"            out->sent = {len(m.fields)};\n        }}\n"
+                if _ends_with_rest(m)
+                else ""
+            )
+            + "        break;"
             for m in t.messages
         )
         enc_cases = "\n".join(
@@ -990,6 +1006,7 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     o.cap = cap;
     o.n = 0u;
     o.full = 0;
+    o.rest = 0u;
     r = {p}__body(msg, &o, 0);
     if (r == {P}_OK && o.full) {{
         r = {P}_E_BUFFER;
@@ -1015,6 +1032,7 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     o.cap = cap;
     o.n = {P}__S;
     o.full = 0;
+    o.rest = 0u;
     r = {p}__body(msg, &o, 1);
     if (r != {P}_OK) {{
         return r;
@@ -1051,6 +1069,11 @@ const char *{p}_result_name(int result)
 }}
 """
         return text
+
+
+def _ends_with_rest(m: TextMessage) -> bool:
+    """Whether the message's last field is a text to the end of the line (`size: rest`)."""
+    return bool(m.fields) and isinstance(m.fields[-1], TextField) and m.fields[-1].rest
 
 
 def _c_string(text: str) -> str:
@@ -1125,7 +1148,8 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
             comma = "" if first else ","
             first = False
             if isinstance(item, TextField):
-                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_field(&j, &c);')
+                read = "j_rest" if item.rest else "j_field"
+                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__{read}(&j, &c);')
                 continue
             groups = f"{item.count}u" if item.count else f"msg->u.{mid(m)}.{ident(item.name)}_count"
             names = []
@@ -1163,6 +1187,16 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
             + "\n".join("    " + line if line else line for line in body.split("\n"))
             + f'\n        {p}__j_str(&j, "}}}}");\n        break;'
         )
+    rest = ""
+    if any(_ends_with_rest(m) for m in text.messages):
+        rest = f"""/* A text to the end of the line: the rest of the fields' text. */
+static void {p}__j_rest({p}__json_t *j, {p}__jcur_t *c)
+{{
+    {p}__j_text(j, c->b + c->pos, c->n - c->pos);
+    c->pos = c->n;
+}}
+
+"""
     talker_length = "    i = 0u;"
     if text.talker:
         talker_length = f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}"
@@ -1238,7 +1272,7 @@ static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
     }}
 }}
 
-static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
+{rest}static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
 {{
     char number[40];
     size_t i;

@@ -165,6 +165,20 @@ static int pfx__alone(const uint8_t *t, size_t n, const char *code, size_t k, co
         (),
     ),
     Piece(
+        r"""/* A text to the end of the line (`size: rest`): the rest of the sentence, separators included. */
+static void pfx__rest(pfx__cursor_t *c, size_t *start, size_t *len)
+{
+    *start = c->more ? c->pos : c->n;
+    *len = c->n - *start;
+    c->more = 0;
+    c->pos = c->n;
+}
+
+""",
+        "rest",
+        (),
+    ),
+    Piece(
         "/* Digits d[0..n) as a number (at most 18 digits: PFX_E_CAPACITY beyond, "
         r"""a number an int64_t may not hold). */
 static int pfx__digits(const uint8_t *d, size_t n, int64_t *out)
@@ -453,7 +467,8 @@ typedef struct {
     uint8_t *b;
     size_t cap;
     size_t n;
-    int full; /* something did not fit */
+    int full;    /* something did not fit */
+    size_t rest; /* where a text to the end of the line begins (0: none; the separators in it are its own) */
 } pfx__out_t;
 
 """,
@@ -723,6 +738,23 @@ static int pfx__carried(char c)
         ("carried",),
     ),
     Piece(
+        r"""/* A text to the end of the line: printable ASCII, none of the framing's characters but its separator. */
+static int pfx__rest_ok(const char *t, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (t[i] < 0x20 || t[i] > 0x7E || (pfx__special((uint8_t)t[i]) && (uint8_t)t[i] != PFX__SEPARATOR)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+""",
+        "rest_ok",
+        ("special",),
+    ),
+    Piece(
         r"""/* 1 when none of t[0..n) is one of a message's own characters `own` (its layout's). */
 static int pfx__avoids(const char *t, size_t n, const char *own)
 {
@@ -874,18 +906,19 @@ MIDDLE = Piece(
 
 #if PFX_ENABLE_ENCODE
 /* Exactly `sent` fields after the address (o->b[PFX__S..n): the address, then each field after a separator): the fields
- * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. */
+ * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. A text to the end of the line
+ * (from o->rest on) is one field, the separators in it its own. */
 static int pfx__trim(pfx__out_t *o, size_t sent)
 {
-    size_t i, k, fields = 0u;
-    for (i = PFX__S; i < o->n; i++) {
+    size_t i, k, fields = 0u, rest = o->rest > 0u ? o->rest : o->n;
+    for (i = PFX__S; i < rest; i++) {
         if (o->b[i] == PFX__SEPARATOR && ++fields > sent) {
             break;
         }
     }
     if (fields > sent) {
         for (k = i; k < o->n; k++) {
-            if (o->b[k] != PFX__SEPARATOR) {
+            if (o->b[k] != PFX__SEPARATOR || k >= rest) {
                 return PFX_E_LENGTH; /* a field after the last one sent has a value */
             }
         }

@@ -9,7 +9,7 @@ from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
 # what of the list the C target generates (its Wireshark dissector does not yet)
-C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts"})
+C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest"})
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
@@ -17,12 +17,13 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a
-    code of its own, "layouts": messages in their own text found by their code alone, without labels)."""
+    code of its own, "layouts": messages in their own text found by their code alone, without labels, "rest": a
+    text field to the end of the line)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
         raise Unsupported("a line ending with bytes above 0x7F (`end`)")
-    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields):
+    if any(isinstance(f, TextField) and f.rest for m in text.messages for f in m.fields) and "rest" not in takes:
         raise Unsupported("a text field to the end of the line (`size: rest`)")
     if text.response_end and "ends" not in takes:
         raise Unsupported("a line ending of its own for each direction (`end: {request: ..., response: ...}`)")

@@ -35,6 +35,8 @@ MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
 # a line ending of bytes above 0x7F (Nextion's FF FF FF) for requests, and one of their own for responses (an
 # ELM327's CR CR `>`, here LF LF `>`)
 MATRIX["framing"]["end"] = {"request": "\xff\xff\xff", "response": "\n\n>"}
+# a checksum in requests only (G-code's numbered lines carry one, the firmware's replies none: a `!` in them is text)
+MATRIX["framing"]["checksum"]["directions"] = ["request"]
 # messages in their own text found by their code alone: a reply under a code of its own of two words, a value glued to
 # its code beside a longer code it begins (LSS's `D1800`), and a separator and list of their own
 MATRIX["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
@@ -382,6 +384,7 @@ def test_random_messages_and_mutated_frames_decode_and_encode_as_python_does(nam
     def agree(case: tuple[str, bytes], data: st.DataObject) -> None:
         direction, frame = case
         check_decode(b, frame, direction)
+        check_decode(b, frame, "response" if direction == "request" else "request")  # read as the other direction
         awaited = bare(b)
         if awaited is not None and direction == awaited.direction:  # read as the reply of values alone awaited
             check_decode(b, frame, direction, expect=awaited)

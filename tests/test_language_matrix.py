@@ -2329,13 +2329,17 @@ def test_messages_found_by_their_code_alone_through_every_output(tmp_path: Path)
         assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines
 
 
-def test_a_text_checksum_in_one_direction_through_every_output() -> None:
-    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C and
-    Wireshark refuse it in one line; requests carry the checksum, responses none (a marker in one is text), with or
-    without the direction given; random messages round trip, through the stream parser too."""
+def test_a_text_checksum_in_one_direction_through_every_output(tmp_path: Path) -> None:
+    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): Wireshark
+    refuses it in one line, the C takes it (it compiles; tests/test_c_text.py holds it to Python); requests carry the
+    checksum, responses none (a marker in one is text), with or without the direction given; random messages round
+    trip, through the stream parser too."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"]["directions"] = ["request"]
-    files = python_and_markdown(case, r"^a text checksum in one direction only \(`checksum.directions`\)$")
+    files = python_and_markdown(
+        case, r"^a text checksum in one direction only \(`checksum.directions`\)$", ("wireshark",)
+    )
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
     assert "; requests only |" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

@@ -19,6 +19,8 @@
 #define NMEA0183__SEPARATOR 0x2Cu    /* ',' */
 #define NMEA0183__MARKER 0x2Au          /* '*': the checksum follows */
 #define NMEA0183__CHECKED 1            /* a checksum is written */
+#define NMEA0183__CHECKS(dir) 1 /* the frames of `dir` carry it */
+#define NMEA0183__AGAIN (-1) /* p__decode_in: read it again as the other direction's (no checksum) */
 #define NMEA0183__REQUIRED 0        /* a frame without one is refused */
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
 #define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
@@ -481,14 +483,16 @@ static int nmea0183__hex_value(uint8_t c)
     return -1;
 }
 
-/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; NMEA0183_E_FRAME,
- * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
- * separator before the marker, it is no part of the fields. */
-static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, size_t *body, size_t *n, int *unchecked)
+/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked where `check`;
+ * NMEA0183_E_FRAME, NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: the line ending
+ * taken off; where its frames write the separator before the marker, it is no part of the fields. */
+static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, int check, size_t *body, size_t *n,
+                        int *unchecked)
 {
     size_t i, end = len, stop, ascii, own = NMEA0183__END_LEN(dir), other = NMEA0183__END_LEN(NMEA0183__OTHER(dir));
     *unchecked = 0;
     (void)dir;
+    (void)check;
     if (len >= own && nmea0183__same(f + len - own, NMEA0183__END(dir), own)) {
         end = len - own; /* the direction's line ending */
     }
@@ -508,7 +512,7 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t 
 #endif
     stop = end;
 #if NMEA0183__CHECKED
-    {
+    if (check) {
         size_t at = end, k;
         uint32_t written = 0u;
         while (at > NMEA0183__S && f[at - 1u] != NMEA0183__MARKER) {
@@ -584,7 +588,7 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
 #endif
     (void)unchecked;
 #if NMEA0183__CHECKED
-    if (!unchecked || NMEA0183__REQUIRED) {
+    if ((!unchecked || NMEA0183__REQUIRED) && NMEA0183__CHECKS(dir)) {
         uint32_t sum;
         if (separated) { /* the separator before the marker, covered by the checksum */
             nmea0183__put(o, NMEA0183__SEPARATOR);
@@ -608,6 +612,23 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
 }
 #endif
 
+
+#if NMEA0183_ENABLE_ENCODE || (NMEA0183_ENABLE_DECODE && 0)
+/* The direction of a message of `kind`. */
+static nmea0183_direction_t nmea0183__direction(nmea0183_kind_t kind)
+{
+    switch (kind) {
+    case NMEA0183_GGA_RESPONSE:
+    case NMEA0183_RMC_RESPONSE:
+    case NMEA0183_VTG_RESPONSE:
+    case NMEA0183_GSA_RESPONSE:
+    case NMEA0183_GSV_RESPONSE:
+        return NMEA0183_RESPONSE;
+    default:
+        return NMEA0183_REQUEST;
+    }
+}
+#endif
 
 #if NMEA0183_ENABLE_DECODE
 /* Global Positioning System Fix Data (GGA, response): each field in turn, an empty one absent. */
@@ -1146,10 +1167,12 @@ static nmea0183_kind_t nmea0183__lookup(const uint8_t *code, size_t n, nmea0183_
 }
 
 /* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's
- * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
-static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
-                       nmea0183_msg_t *out)
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). `again`: a frame of the other
+ * direction's (its line ending taken off), read as `dir`, which carries no checksum. */
+static int nmea0183__decode_in(const uint8_t *frame, size_t len, nmea0183_direction_t dir, int again, nmea0183_kind_t expect,
+                          nmea0183_kind_t reply, nmea0183_msg_t *out)
 {
+    const nmea0183_direction_t sent_as = again ? NMEA0183__OTHER(dir) : dir;
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
     nmea0183_kind_t kind;
@@ -1158,13 +1181,13 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         return NMEA0183_E_ARG;
     }
     out->kind = NMEA0183_KIND_NONE;
-    if (!NMEA0183__DECODES(dir)) { /* the other side's direction, left out of this build */
+    if (!NMEA0183__DECODES(sent_as)) { /* the other side's direction, left out of this build */
         return NMEA0183_E_ARG;
     }
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
-    r = nmea0183__unframe(frame, len, dir, &body, &n, &unchecked);
+    r = nmea0183__unframe(frame, len, sent_as, !again && NMEA0183__CHECKS(dir), &body, &n, &unchecked);
     if (r != NMEA0183_OK) {
         return r;
     }
@@ -1221,6 +1244,16 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     }
     if (r == NMEA0183_OK) {
         out->kind = kind;
+    }
+    return r;
+}
+
+static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
+                       nmea0183_msg_t *out)
+{
+    int r = nmea0183__decode_in(frame, len, dir, 0, expect, reply, out);
+    if (r == NMEA0183__AGAIN) { /* a code of the other direction alone: its frame is text to its end, the marker too */
+        r = nmea0183__decode_in(frame, len, NMEA0183__OTHER(dir), 1, expect, reply, out);
     }
     return r;
 }
@@ -2092,20 +2125,6 @@ void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
 #endif
 
 #if NMEA0183_ENABLE_ENCODE
-/* The direction of a message of `kind`. */
-static nmea0183_direction_t nmea0183__direction(nmea0183_kind_t kind)
-{
-    switch (kind) {
-    case NMEA0183_GGA_RESPONSE:
-    case NMEA0183_RMC_RESPONSE:
-    case NMEA0183_VTG_RESPONSE:
-    case NMEA0183_GSA_RESPONSE:
-    case NMEA0183_GSV_RESPONSE:
-        return NMEA0183_RESPONSE;
-    default:
-        return NMEA0183_REQUEST;
-    }
-}
 
 int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {

@@ -1581,8 +1581,8 @@ FRAMING = Obj(
                     Str(choices=("request", "response")),
                     "The directions whose frames carry it (default both): G-code's numbered lines carry one, the "
                     "firmware's `ok` and `Resend: 124` none (`directions: [request]`); a frame of the other "
-                    "direction is text to its end, the marker too. The C target and the Wireshark dissector refuse "
-                    "a checksum in one direction only, saying so.",
+                    "direction is text to its end, the marker too. The C target writes and reads it; the Wireshark "
+                    "dissector refuses a checksum in one direction only, saying so.",
                     example=["request"],
                 ),
             },

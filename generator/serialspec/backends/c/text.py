@@ -459,6 +459,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             if layout
             else ""
         )
+        t = self.text
+        if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
+            own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
         for item in _items(m):
             if isinstance(item, TextField):
                 checks.append(self.check(item, "m->", own, rest_own))
@@ -670,6 +673,11 @@ static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
             + f"    ((dir) == {P}_RESPONSE ? sizeof({p}__response_end) - 1u : sizeof({p}__end) - 1u)\n"
         )
 
+    def marked(self) -> bool:
+        """Whether every frame carries the checksum's marker (else texts of the directions without may hold it)."""
+        t = self.text
+        return t.checksum is not None and len(t.checksum_directions) == 2
+
     def direction(self) -> str:
         """The direction of a message of each kind (encode writes its line ending)."""
         p, P = self.p, self.P
@@ -702,7 +710,21 @@ void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
         p, P, t = self.p, self.P, self.text
         bare = [m for m in t.messages if m.values_only]  # replies of values alone (`values_only`)
         ends = self.ends()
-        special_characters = sorted({t.start, t.separator, t.marker, *t.end, *t.response_end} - {""})
+        # the checksum's marker where every frame carries it (else: a check of the messages of the directions that do)
+        marker = t.marker if self.marked() else ""
+        special_characters = sorted({t.start, t.separator, marker, *t.end, *t.response_end} - {""})
+        one_way = t.checksum is not None and len(t.checksum_directions) == 1
+        checks = (
+            "0" if t.checksum is None else "1" if not one_way else f"((dir) == {P}_{t.checksum_directions[0].upper()})"
+        )
+        again = (
+            f"    if (r == {P}_OK && !again && {P}__CHECKS(dir) && !{P}__CHECKS({p}__direction(kind))) {{\n"
+            f"        return {P}__AGAIN; /* a code of the other direction alone (runtime/text.py _decode_checked) */\n"
+            f"    }}\n"
+            if one_way
+            else ""
+        )
+        direction = f"#if {P}_ENABLE_ENCODE || ({P}_ENABLE_DECODE && {int(one_way)})\n{self.direction()}\n#endif\n\n"
         checked = t.checksum is not None
         checksum, reflects = "", False
         if t.checksum is not None:
@@ -864,6 +886,8 @@ static int {p}__special(uint8_t c)
 {start}#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
 #define {P}__MARKER {_byte(t.marker)}          /* {comment(repr(t.marker))}: the checksum follows */
 #define {P}__CHECKED {int(checked)}            /* a checksum is written */
+#define {P}__CHECKS(dir) {checks} /* the frames of `dir` carry it */
+#define {P}__AGAIN (-1) /* p__decode_in: read it again as the other direction's (no checksum) */
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
 #define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
@@ -902,7 +926,7 @@ static int {p}__is(const uint8_t *b, size_t n, const char *s)
 #endif
 
 {written([special], helpers)}{reflect}{checksum}{runtime}
-#if {P}_ENABLE_DECODE
+{direction}#if {P}_ENABLE_DECODE
 {decoders}
 
 /* The message a text code names: the one it names, or the one of `dir` where it names a request and a response. */
@@ -914,10 +938,12 @@ static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir
 }}
 
 {bare_helpers}{alone_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's
- * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
-static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
-                       {p}_msg_t *out)
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). `again`: a frame of the other
+ * direction's (its line ending taken off), read as `dir`, which carries no checksum. */
+static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir, int again, {p}_kind_t expect,
+                          {p}_kind_t reply, {p}_msg_t *out)
 {{
+    const {p}_direction_t sent_as = again ? {P}__OTHER(dir) : dir;
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
     {p}_kind_t kind;
@@ -926,13 +952,13 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
         return {P}_E_ARG;
     }}
     out->kind = {P}_KIND_NONE;
-    if (!{P}__DECODES(dir)) {{ /* the other side's direction, left out of this build */
+    if (!{P}__DECODES(sent_as)) {{ /* the other side's direction, left out of this build */
         return {P}_E_ARG;
     }}
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}
-    r = {p}__unframe(frame, len, dir, &body, &n, &unchecked);
+    r = {p}__unframe(frame, len, sent_as, !again && {P}__CHECKS(dir), &body, &n, &unchecked);
     if (r != {P}_OK) {{
         return r;
     }}
@@ -963,8 +989,18 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     default:
         return {P}_E_UNKNOWN;
     }}
-    if (r == {P}_OK) {{
+{again}    if (r == {P}_OK) {{
         out->kind = kind;
+    }}
+    return r;
+}}
+
+static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
+                       {p}_msg_t *out)
+{{
+    int r = {p}__decode_in(frame, len, dir, 0, expect, reply, out);
+    if (r == {P}__AGAIN) {{ /* a code of the other direction alone: its frame is text to its end, the marker too */
+        r = {p}__decode_in(frame, len, {P}__OTHER(dir), 1, expect, reply, out);
     }}
     return r;
 }}
@@ -1017,7 +1053,6 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 
 {parser}
 #if {P}_ENABLE_ENCODE
-{self.direction()}
 
 int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {{

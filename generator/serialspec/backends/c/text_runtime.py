@@ -813,14 +813,16 @@ static double pfx__angle_value(const pfx_angle_t *a)
         (),
     ),
     Piece(
-        r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
- * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
- * separator before the marker, it is no part of the fields. */
-static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_t *body, size_t *n, int *unchecked)
+        r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked where `check`;
+ * PFX_E_FRAME, PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: the line ending
+ * taken off; where its frames write the separator before the marker, it is no part of the fields. */
+static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, int check, size_t *body, size_t *n,
+                        int *unchecked)
 {
     size_t i, end = len, stop, ascii, own = PFX__END_LEN(dir), other = PFX__END_LEN(PFX__OTHER(dir));
     *unchecked = 0;
     (void)dir;
+    (void)check;
     if (len >= own && pfx__same(f + len - own, PFX__END(dir), own)) {
         end = len - own; /* the direction's line ending */
     }
@@ -848,7 +850,7 @@ static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_
 # the checksum read and written where the protocol has one (text.py leaves them out otherwise)
 _CHECKED_READ = Piece(
     r"""#if PFX__CHECKED
-    {
+    if (check) {
         size_t at = end, k;
         uint32_t written = 0u;
         while (at > PFX__S && f[at - 1u] != PFX__MARKER) {
@@ -948,7 +950,7 @@ static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated,
 
 _CHECKED_WRITE = Piece(
     r"""#if PFX__CHECKED
-    if (!unchecked || PFX__REQUIRED) {
+    if ((!unchecked || PFX__REQUIRED) && PFX__CHECKS(dir)) {
         uint32_t sum;
         if (separated) { /* the separator before the marker, covered by the checksum */
             pfx__put(o, PFX__SEPARATOR);

@@ -9,7 +9,9 @@ from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
 # what of the list the C target generates (its Wireshark dissector does not yet)
-C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest"})
+C_TAKES = frozenset(
+    {"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest", "one_way"}
+)
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
@@ -18,7 +20,7 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a
     code of its own, "layouts": messages in their own text found by their code alone, without labels, "rest": a
-    text field to the end of the line)."""
+    text field to the end of the line, "one_way": a checksum in one direction only)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -38,7 +40,7 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")
     if text.checksum is not None and text.checksum_format == "decimal" and "decimal" not in takes:
         raise Unsupported("a text checksum written in decimal (`format: decimal`)")
-    if text.checksum is not None and text.checksum_directions != ("request", "response"):
+    if text.checksum is not None and text.checksum_directions != ("request", "response") and "one_way" not in takes:
         raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
     if text.checksum is not None and text.checksum_separated and "separated" not in takes:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")

@@ -35,6 +35,8 @@ MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
 # a line ending of bytes above 0x7F (Nextion's FF FF FF) for requests, and one of their own for responses (an
 # ELM327's CR CR `>`, here LF LF `>`)
 MATRIX["framing"]["end"] = {"request": "\xff\xff\xff", "response": "\n\n>"}
+# a start of its own for each direction (Lynxmotion LSS: `#` asks, `*` answers; here `$`)
+MATRIX["framing"]["start"] = {"request": "#", "response": "$"}
 # a checksum in requests only (G-code's numbered lines carry one, the firmware's replies none: a `!` in them is text)
 MATRIX["framing"]["checksum"]["directions"] = ["request"]
 # messages in their own text found by their code alone: a reply under a code of its own of two words, a value glued to
@@ -283,7 +285,7 @@ def stream_agrees(
     at = 0
     for frame in (bytes.fromhex(a[6:]) for a in answers if a.startswith("frame ")):
         found = stream.find(frame, at)
-        assert found >= 0 and frame.startswith(b.framing.start.encode()), (frame, stream)
+        assert found >= 0 and frame.startswith(b.framing.start_of(direction).encode()), (frame, stream)
         at = found + len(frame)
 
 
@@ -403,6 +405,7 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
     b = built(name)
     start, end = b.framing.start.encode(), b.framing.end.encode("latin-1")
     other = b.framing.response_end.encode("latin-1")  # the responses' own line ending, where they have one
+    answer = b.framing.response_start.encode()  # the responses' own start, where they have one
 
     @settings(max_examples=examples(25), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(directions(b)), st.data())
@@ -417,7 +420,7 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
                 )
             ),  # fmt: skip
             st.binary(max_size=6),
-            st.sampled_from([start, end, other, start + b"X" * (b.framing.max_length + 3), b"\r", b"\n"]),
+            st.sampled_from([start, end, other, answer, start + b"X" * (b.framing.max_length + 3), b"\r", b"\n"]),
         )
         stream = b"".join(data.draw(st.lists(piece, max_size=8)))
         sizes = data.draw(st.lists(st.integers(0, 9), min_size=1, max_size=6))

@@ -16,6 +16,8 @@
 /* ---- the frame, as the spec says (`$`, the talker id and the sentence id (GPGGA), each field after a comma, then `*` and the XOR of every character between `$` and `*` as two upper-case hex digits, then CR LF; at most 82 characters (gpsd: "NMEA Revealed"). NMEA 0183 makes the checksum optional for some sentences, so a sentence without one is accepted unchecked.) ---- */
 #define NMEA0183__S 1u /* the start character's bytes: 1, or 0 where every line is a frame */
 #define NMEA0183__START 0x24u /* '$' */
+#define NMEA0183__START_OF(dir) NMEA0183__START
+#define NMEA0183__IS_START(c) ((c) == NMEA0183__START)
 #define NMEA0183__SEPARATOR 0x2Cu    /* ',' */
 #define NMEA0183__MARKER 0x2Au          /* '*': the checksum follows */
 #define NMEA0183__CHECKED 1            /* a checksum is written */
@@ -506,7 +508,7 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t 
         }
     }
 #if NMEA0183__S
-    if (end < 1u || f[0] != NMEA0183__START) {
+    if (end < 1u || f[0] != NMEA0183__START_OF(dir)) { /* the direction's start */
         return NMEA0183_E_FRAME;
     }
 #endif
@@ -584,7 +586,7 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
     (void)separated;
     (void)dir;
 #if NMEA0183__S
-    o->b[0] = NMEA0183__START;
+    o->b[0] = NMEA0183__START_OF(dir);
 #endif
     (void)unchecked;
 #if NMEA0183__CHECKED
@@ -1968,10 +1970,10 @@ int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, si
 }
 
 #if NMEA0183_ENABLE_PARSER
-/* Where `c` is in b[from..n), n if nowhere. */
-static size_t nmea0183__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
+/* Where a start (of either direction) is in b[from..n), n if nowhere. */
+static size_t nmea0183__find(const uint8_t *b, size_t from, size_t n)
 {
-    while (from < n && b[from] != c) {
+    while (from < n && !NMEA0183__IS_START(b[from])) {
         from++;
     }
     return from;
@@ -2008,14 +2010,14 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
         p->buf[p->n++] = byte;
     }
     for (;;) {
-        size_t start = nmea0183__find(p->buf, 0u, p->n, NMEA0183__START), end, restart;
+        size_t start = nmea0183__find(p->buf, 0u, p->n), end, restart;
         if (start == p->n) {
             p->n = 0u;
             return 0;
         }
         nmea0183__drop(p, start);
         end = nmea0183__find_end(p->buf, 1u, p->n, p->dir);
-        restart = nmea0183__find(p->buf, 1u, p->n, NMEA0183__START);
+        restart = nmea0183__find(p->buf, 1u, p->n);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
                 p->errors++;
@@ -2052,7 +2054,7 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
 
 void nmea0183_parser_gap(nmea0183_parser_t *parser)
 {
-    if (parser->n > 0u) { /* it begins with the start character */
+    if (parser->n > 0u) { /* it begins with a start character */
         parser->errors++;
     }
     parser->n = 0u;

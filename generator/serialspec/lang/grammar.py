@@ -1520,8 +1520,8 @@ FRAMING = Obj(
             "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
             "line ending) and the stream parser resynchronises at the next line ending. A mapping gives each "
             'direction its own (Lynxmotion LSS: `start: {request: "#", response: "*"}`, `#5QD` asked and '
-            "`*5QD1800` answered): a frame's start then says its direction. The C target and the Wireshark "
-            "dissector refuse starts that differ by direction, saying so.",
+            "`*5QD1800` answered): a frame's start then says its direction. The C target writes and reads them; "
+            "the Wireshark dissector refuses starts that differ by direction, saying so.",
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),

@@ -712,7 +712,7 @@ void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
         ends = self.ends()
         # the checksum's marker where every frame carries it (else: a check of the messages of the directions that do)
         marker = t.marker if self.marked() else ""
-        special_characters = sorted({t.start, t.separator, marker, *t.end, *t.response_end} - {""})
+        special_characters = sorted({t.start, t.response_start, t.separator, marker, *t.end, *t.response_end} - {""})
         one_way = t.checksum is not None and len(t.checksum_directions) == 1
         checks = (
             "0" if t.checksum is None else "1" if not one_way else f"((dir) == {P}_{t.checksum_directions[0].upper()})"
@@ -868,7 +868,20 @@ static int {p}__special(uint8_t c)
             else f"#define {P}__REPLY(p) {P}_KIND_NONE\n#define {P}__ANSWERED(p, out) ((void)0)\n"
             f"#define {P}__INIT_REPLY(p) ((void)0)\n"
         )
-        start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
+        start = ""
+        if t.start and not t.response_start:
+            start = (
+                f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n"
+                f"#define {P}__START_OF(dir) {P}__START\n#define {P}__IS_START(c) ((c) == {P}__START)\n"
+            )
+        elif t.start:  # each direction its own (Lynxmotion LSS: `#` asks, `*` answers)
+            start = (
+                f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))}: the requests' */\n"
+                f"#define {P}__RESPONSE_START {_byte(t.response_start)} /* {comment(repr(t.response_start))}: the "
+                "responses' */\n"
+                f"#define {P}__START_OF(dir) ((dir) == {P}_RESPONSE ? {P}__RESPONSE_START : {P}__START)\n"
+                f"#define {P}__IS_START(c) ((c) == {P}__START || (c) == {P}__RESPONSE_START)\n"
+            )
         room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
 #include "{p}.h"

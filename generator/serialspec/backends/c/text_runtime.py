@@ -836,7 +836,7 @@ static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, int c
         }
     }
 #if PFX__S
-    if (end < 1u || f[0] != PFX__START) {
+    if (end < 1u || f[0] != PFX__START_OF(dir)) { /* the direction's start */
         return PFX_E_FRAME;
     }
 #endif
@@ -941,7 +941,7 @@ static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated,
     (void)separated;
     (void)dir;
 #if PFX__S
-    o->b[0] = PFX__START;
+    o->b[0] = PFX__START_OF(dir);
 #endif
     (void)unchecked;
 """,
@@ -1003,10 +1003,10 @@ BEFORE_PARSER = Piece(
 # the line parser (text.py writes one of the two pushes, then PARSER, after the messages' code)
 START_PUSH = Piece(
     r"""#if PFX_ENABLE_PARSER
-/* Where `c` is in b[from..n), n if nowhere. */
-static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
+/* Where a start (of either direction) is in b[from..n), n if nowhere. */
+static size_t pfx__find(const uint8_t *b, size_t from, size_t n)
 {
-    while (from < n && b[from] != c) {
+    while (from < n && !PFX__IS_START(b[from])) {
         from++;
     }
     return from;
@@ -1043,14 +1043,14 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
         p->buf[p->n++] = byte;
     }
     for (;;) {
-        size_t start = pfx__find(p->buf, 0u, p->n, PFX__START), end, restart;
+        size_t start = pfx__find(p->buf, 0u, p->n), end, restart;
         if (start == p->n) {
             p->n = 0u;
             return 0;
         }
         pfx__drop(p, start);
         end = pfx__find_end(p->buf, 1u, p->n, p->dir);
-        restart = pfx__find(p->buf, 1u, p->n, PFX__START);
+        restart = pfx__find(p->buf, 1u, p->n);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
                 p->errors++;
@@ -1087,7 +1087,7 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 
 void pfx_parser_gap(pfx_parser_t *parser)
 {
-    if (parser->n > 0u) { /* it begins with the start character */
+    if (parser->n > 0u) { /* it begins with a start character */
         parser->errors++;
     }
     parser->n = 0u;

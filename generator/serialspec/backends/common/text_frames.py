@@ -10,7 +10,19 @@ from serialspec.lang.model import TextField, TextFrame
 
 # what of the list the C target generates (its Wireshark dissector does not yet)
 C_TAKES = frozenset(
-    {"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest", "one_way"}
+    {
+        "lines",
+        "decimal",
+        "separated",
+        "values_only",
+        "high_end",
+        "ends",
+        "codes",
+        "layouts",
+        "rest",
+        "one_way",
+        "starts",
+    }
 )
 
 
@@ -20,7 +32,8 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a
     code of its own, "layouts": messages in their own text found by their code alone, without labels, "rest": a
-    text field to the end of the line, "one_way": a checksum in one direction only)."""
+    text field to the end of the line, "one_way": a checksum in one direction only,
+    "starts": a start of its own for each direction)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -44,7 +57,7 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a text checksum in one direction only (`checksum.directions`)")
     if text.checksum is not None and text.checksum_separated and "separated" not in takes:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")
-    if text.response_start:
+    if text.response_start and "starts" not in takes:
         raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
     if text.address is not None:
         raise Unsupported("an address before the text code (`framing.address`)")

@@ -37,6 +37,9 @@ MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
 MATRIX["framing"]["end"] = {"request": "\xff\xff\xff", "response": "\n\n>"}
 # a start of its own for each direction (Lynxmotion LSS: `#` asks, `*` answers; here `$`)
 MATRIX["framing"]["start"] = {"request": "#", "response": "$"}
+# an address before the code, every message's first field (LSS's servo id: `#5QD`)
+MATRIX["framing"]["address"] = "unit"
+MATRIX["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
 # a checksum in requests only (G-code's numbered lines carry one, the firmware's replies none: a `!` in them is text)
 MATRIX["framing"]["checksum"]["directions"] = ["request"]
 # messages in their own text found by their code alone: a reply under a code of its own of two words, a value glued to

@@ -1175,6 +1175,7 @@ static int nmea0183__decode_in(const uint8_t *frame, size_t len, nmea0183_direct
                           nmea0183_kind_t reply, nmea0183_msg_t *out)
 {
     const nmea0183_direction_t sent_as = again ? NMEA0183__OTHER(dir) : dir;
+
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
     nmea0183_kind_t kind;
@@ -1904,7 +1905,7 @@ static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183
     return NMEA0183_OK;
 }
 
-/* Talker, code and fields (range-checked when `check`), from o's position on. */
+/* Address, talker, code and fields (range-checked when `check`), from o's position on. */
 static int nmea0183__body(const nmea0183_msg_t *msg, nmea0183__out_t *o, int check)
 {
     size_t i;
@@ -2131,8 +2132,9 @@ void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
 int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {
     nmea0183__out_t o;
-    size_t i;
+    size_t i, at = 0u;
     int r;
+    (void)at;
     if (msg == NULL || buf == NULL || len == NULL) {
         return NMEA0183_E_ARG;
     }

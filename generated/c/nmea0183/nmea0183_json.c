@@ -91,7 +91,8 @@ size_t nmea0183_to_json(const nmea0183_msg_t *msg, char *out, size_t cap)
     nmea0183__json_t j;
     nmea0183__jcur_t c;
     uint8_t body[NMEA0183__JSON_BODY];
-    size_t len = 0u, g = 0u;
+    size_t len = 0u, g = 0u, lead = 0u;
+    (void)lead;
     j.out = out;
     j.cap = cap;
     j.n = 0u;
@@ -104,7 +105,7 @@ size_t nmea0183_to_json(const nmea0183_msg_t *msg, char *out, size_t cap)
     c.pos = 0u;
     c.sep = 0x2Cu;
     c.list = 0x2Cu;
-    while (c.pos < c.n && body[c.pos] != 0x2Cu) { /* the address: skipped */
+    while (c.pos < c.n && body[c.pos] != 0x2Cu) { /* the talker and code: skipped */
         c.pos++;
     }
     if (c.pos < c.n) {

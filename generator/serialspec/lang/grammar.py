@@ -1608,8 +1608,8 @@ FRAMING = Obj(
             "text: a shared integer field (its name in `fields:`) that every message carries first, its digits "
             "written right after the start and before the talker and code, with nothing between (Lynxmotion LSS's "
             "servo id: `address: id` reads `#5D1800` as id 5, code D, 1800). Messages, JSON and client methods have "
-            "it as a field; the simulator answers with the request's. The C target and the Wireshark dissector "
-            "refuse it, saying so.",
+            "it as a field; the simulator answers with the request's. The C target writes and reads it; the "
+            "Wireshark dissector refuses it, saying so.",
             example="id",
         ),
         "max_length": Int(

@@ -63,6 +63,14 @@ def _items(m: TextMessage) -> list[TextField | TextRepeat]:
     return list(m.fields)
 
 
+def _sent(m: TextMessage) -> list[TextField | TextRepeat]:
+    """The fields written after the code: all but an address (`framing.address`: its digits come before it)."""
+    return [f for f in m.fields if not (isinstance(f, TextField) and f.address)]
+
+
+_SENT = _sent
+
+
 class TextC:
     """One text protocol's C."""
 
@@ -334,7 +342,7 @@ const char *{p}_result_name(int result);
         p, P = self.p, self.P
         lines: list[str] = []
         at = 0
-        for item in _items(m):
+        for item in _SENT(m):
             if isinstance(item, TextField):
                 lines.append(self.read(item, "m->"))
                 at += 1
@@ -462,7 +470,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         t = self.text
         if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
             own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
-        for item in _items(m):
+        for item in _SENT(m):
             if isinstance(item, TextField):
                 checks.append(self.check(item, "m->", own, rest_own))
                 writes.append(self.write(item, "m->", part))
@@ -576,14 +584,67 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
         c.pos = 0u;
     }}
 """
-        write = f"""    if ({P}__BARE(msg->kind) && !o.full && o.n > {P}__S && o.b[{P}__S] == {P}__SEPARATOR) {{
-        for (i = {P}__S; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
+        write = f"""    for (at = {P}__S; at < o.n && o.b[at] >= 0x30u && o.b[at] <= 0x39u; at++) {{
+    }} /* past an address */
+    if ({P}__BARE(msg->kind) && !o.full && o.n > at && o.b[at] == {P}__SEPARATOR) {{
+        for (i = at; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
             o.b[i] = o.b[i + 1u];
         }}
         o.n--;
     }}
 """
         return helpers, read, write, f"{p}__bare_reply(expect)"
+
+    def address(self) -> tuple[str, str, str]:
+        """An address before the code (`framing.address`: Lynxmotion LSS's servo id, `#5QD`): every message's first
+        field, its decimal digits right after the start (runtime/text.py TextFraming._decode_body): the decoder's
+        reading of them, __body's writing of them (range-checked first) and the decoder's setting of every message's
+        member after its fields."""
+        P, f = self.P, self.text.address
+        if f is None:
+            return "", "", ""
+        n = ident(f.name)
+        sets = "\n".join(
+            f"        case {P}_{mid(m).upper()}:\n            out->u.{mid(m)}.{n} = number;\n"
+            f"            out->u.{mid(m)}.has_{n} = digits > 0u;\n            break;"
+            for m in self.text.messages
+        )
+        read = f"""    while (digits < n && frame[body + digits] >= 0x30u && frame[body + digits] <= 0x39u) {{
+        digits++; /* the address: the digits right after the start */
+    }}
+    if (digits > 18u) {{
+        return {P}_E_CAPACITY;
+    }}
+    for (i = 0u; i < digits; i++) {{
+        number = number * 10 + (int64_t)(frame[body + i] - 0x30u);
+    }}
+    body += digits;
+    n -= digits;
+"""
+        set_ = f"""    if (r == {P}_OK) {{
+        switch (kind) {{ /* the address, every message's first field */
+{sets}
+        default:
+            break;
+        }}
+    }}
+"""
+        writes = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n"
+            + "\n".join("    " + line for line in self.check(f, f"msg->u.{mid(m)}.").split("\n")).replace(
+                f"    if (msg->u.{mid(m)}.has_{n} &&", f"    if (check && msg->u.{mid(m)}.has_{n} &&"
+            )
+            + f"\n        if (msg->u.{mid(m)}.has_{n}) {{\n"
+            f"            {self.call('put_integer')}(o, msg->u.{mid(m)}.{n}, {f.width}u);\n        }}\n        break;"
+            for m in self.text.messages
+        )
+        write = f"""    switch (msg->kind) {{ /* the address first, its digits before the talker and code */
+{writes}
+    default:
+        break;
+    }}
+"""
+        return read, write, set_
 
     def alone_decode(self) -> tuple[str, str, str]:
         """Messages in their own layout, found by their code alone (an ELM327's reply `41 0C 1A F8 `, an AT modem's
@@ -756,6 +817,8 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 """
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
         alone_helpers, alone_read, own_kinds = self.alone_decode()
+        address_read, address_write, address_set = self.address()
+        address_decl = "    size_t digits = 0u;\n    int64_t number = 0;\n" if address_read else ""
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}
         for m in t.messages:
@@ -773,8 +836,8 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             f"    case {P}_{mid(m).upper()}:\n        memset(&out->u.{mid(m)}, 0, sizeof(out->u.{mid(m)}));\n"
             f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n"
             + (
-                f"        if (out->sent > {len(m.fields)}) {{ /* a text to the end of the line is one field */\n"
-                f"            out->sent = {len(m.fields)};\n        }}\n"
+                f"        if (out->sent > {len(_sent(m))}) {{ /* a text to the end of the line is one field */\n"
+                f"            out->sent = {len(_sent(m))};\n        }}\n"
                 if _ends_with_rest(m)
                 else ""
             )
@@ -957,6 +1020,7 @@ static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir,
                           {p}_kind_t reply, {p}_msg_t *out)
 {{
     const {p}_direction_t sent_as = again ? {P}__OTHER(dir) : dir;
+{address_decl}
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
     {p}_kind_t kind;
@@ -975,7 +1039,7 @@ static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir,
     if (r != {P}_OK) {{
         return r;
     }}
-    address = n;
+{address_read}    address = n;
     for (i = n; i > 0u; i--) {{
         if (frame[body + i - 1u] == {P}__SEPARATOR) {{
             seps++;
@@ -1002,7 +1066,7 @@ static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir,
     default:
         return {P}_E_UNKNOWN;
     }}
-{again}    if (r == {P}_OK) {{
+{again}{address_set}    if (r == {P}_OK) {{
         out->kind = kind;
     }}
     return r;
@@ -1031,10 +1095,10 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 
 {encoders}
 
-/* Talker, code and fields (range-checked when `check`), from o's position on. */
+/* Address, talker, code and fields (range-checked when `check`), from o's position on. */
 static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
 {{
-{talker_write_bare}
+{address_write}{talker_write_bare}
     switch (msg->kind) {{
 {enc_cases}
     case {P}_KIND_NONE:
@@ -1070,8 +1134,9 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {{
     {p}__out_t o;
-    size_t i;
+    size_t i, at = 0u;
     int r;
+    (void)at;
     if (msg == NULL || buf == NULL || len == NULL) {{
         return {P}_E_ARG;
     }}
@@ -1195,6 +1260,9 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
         for item in m.fields:
             comma = "" if first else ","
             first = False
+            if isinstance(item, TextField) and item.address:  # its digits, first in the text
+                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_text(&j, body, lead);')
+                continue
             if isinstance(item, TextField):
                 read = "j_rest" if item.rest else "j_field"
                 parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__{read}(&j, &c);')
@@ -1221,7 +1289,7 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
                     if text.talker
                     else "    c.pos = 0u;\n"
                 )
-                + f"    c.pos += {len(m.code) + len(after)}u;\n"
+                + f"    c.pos += {'lead + ' if text.address else ''}{len(m.code) + len(after)}u;\n"
                 + (f"    c.n = len >= {len(layout.end)}u ? len - {len(layout.end)}u : 0u;\n" if layout.end else "")
                 + f"    c.pos = c.pos < c.n ? c.pos : c.n;\n"
                 f"    c.sep = {_byte(layout.separator)};\n    c.list = {_byte(layout.list or layout.separator)};\n"
@@ -1245,6 +1313,10 @@ static void {p}__j_rest({p}__json_t *j, {p}__jcur_t *c)
 }}
 
 """
+    lead = ""
+    if text.address is not None:  # the address's digits, before the talker and code
+        lead = "    while (lead < len && body[lead] >= 0x30u && body[lead] <= 0x39u) {\n        lead++;\n    }\n"
+        lead += "    c.pos = lead;\n"
     talker_length = "    i = 0u;"
     if text.talker:
         talker_length = f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}"
@@ -1336,7 +1408,8 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     {p}__json_t j;
     {p}__jcur_t c;
     uint8_t body[{P}__JSON_BODY];
-    size_t len = 0u, g = 0u;
+    size_t len = 0u, g = 0u, lead = 0u;
+    (void)lead;
     j.out = out;
     j.cap = cap;
     j.n = 0u;
@@ -1349,7 +1422,7 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     c.pos = 0u;
     c.sep = {_byte(text.separator)};
     c.list = {_byte(text.separator)};
-    while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the address: skipped */
+{lead}    while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the talker and code: skipped */
         c.pos++;
     }}
     if (c.pos < c.n) {{

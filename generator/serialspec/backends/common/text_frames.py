@@ -22,6 +22,7 @@ C_TAKES = frozenset(
         "rest",
         "one_way",
         "starts",
+        "address",
     }
 )
 
@@ -33,7 +34,7 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a
     code of its own, "layouts": messages in their own text found by their code alone, without labels, "rest": a
     text field to the end of the line, "one_way": a checksum in one direction only,
-    "starts": a start of its own for each direction)."""
+    "starts": a start of its own for each direction, "address": an address before the code)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -59,5 +60,5 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a separator before the text checksum (`checksum.separated`)")
     if text.response_start and "starts" not in takes:
         raise Unsupported("a start of its own for each direction (`start: {request: ..., response: ...}`)")
-    if text.address is not None:
+    if text.address is not None and "address" not in takes:
         raise Unsupported("an address before the text code (`framing.address`)")

@@ -51,6 +51,27 @@ MATRIX["commands"] |= {
         "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
     },
     "longer": {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}},
+    # a message's own text with a start and end (GRBL's `[MSG:...]`, `[GC:...]`), two messages sharing it
+    "bracket": {
+        "code": "MSG",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "[", "end": "]", "separator": ":"},
+            "fields": {
+                "a": "integer",
+                "t": "text",
+                "r": {"type": "repeat", "max_count": 2, "fields": {"x": "integer"}},
+            },
+        },
+    },
+    "bracket2": {
+        "code": "GC",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "[", "end": "]", "separator": ":"},
+            "fields": {"b": "integer"},
+        },
+    },
     "pairs": {
         "code": "PR",
         "response": {

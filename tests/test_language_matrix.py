@@ -2163,7 +2163,7 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
     for emitter in emitters():
         if emitter.name in ("c", "wireshark"):
             with pytest.raises(
-                Unsupported, match=r"^a message's own text (layout \(`text:`\)$|with a start or labels)"
+                Unsupported, match=r"^a message's own text (layout \(`text:`\)$|with labels \(`text: \{named: )"
             ):
                 emitter.files(protocol)
             continue
@@ -2457,7 +2457,7 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
             "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
         },
     }
-    files = python_and_markdown(case, r"^a message's own text (layout \(`text:`\)$|with a start or labels)")
+    files = python_and_markdown(case, r"^a message's own text (layout \(`text:`\)$|with labels \(`text: \{named: )")
     assert "written as its label glued to its value" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

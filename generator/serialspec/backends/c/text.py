@@ -460,7 +460,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         layout = m.layout
         own, part, joined = "", "", ""
         if layout is not None:  # its own separator (a repeat's values joined by `list`) and characters
-            own = "".join(sorted({layout.end, layout.separator, layout.list, layout.after_code or ""} - {""}))
+            own = "".join(
+                sorted({layout.start, layout.end, layout.separator, layout.list, layout.after_code or ""} - {""})
+            )
             part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
         rest_own = (
             "".join(sorted(set(own) - {layout.separator, layout.after_code or "", self.text.separator}))
@@ -492,7 +494,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             after = layout.separator if layout.after_code is None else layout.after_code
             written = (
                 f"    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);\n    fields = o->n;\n{written}\n"
-                f"    if (o->n == fields) {{ /* no text after the code: the code alone */\n"
+                f"    if ({'first' if layout.start else 'o->n == fields'}) {{ /* no field's text: the code alone */\n"
                 f"        o->n = code;\n    }}\n"
                 f"    {self.call('put_text')}(o, {_c_string(layout.end)}, {len(layout.end)}u);"
             )
@@ -646,14 +648,76 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
 """
         return read, write, set_
 
+    def framed(self) -> tuple[str, str]:
+        """Messages in their own text with a start (GRBL's `[MSG:...]`, runtime/text.py TextFraming._decode_in): the
+        decoder's reading of a frame whose text starts with a layout's start and ends with its end (the talker and
+        code up to its separator, then its fields), and __body's writing of the start before the talker."""
+        p, P, t = self.p, self.P, self.text
+        layouts = list(dict.fromkeys(m.layout for m in t.messages if m.layout is not None and m.layout.start))
+        if not layouts:
+            return "", ""
+        reads = []
+        for index, layout in enumerate(layouts):
+            kinds = " || ".join(f"kind == {P}_{mid(m).upper()}" for m in t.messages if m.layout == layout)
+            s, e = len(layout.start), len(layout.end)
+            starts = f'{self.call("alone")}(frame + body, n, {_c_string(layout.start)}, {s}u, "", 0u, '
+            ends = f"{_c_string(layout.end)}, {e}u, &at, &inner)"
+            reads.append(f"""    if (!own && {starts}{ends} &&
+        n >= {s + e}u) {{ /* its own text: {comment(repr(layout.start))} ... (layout {index}) */
+        const uint8_t *t = frame + body + {s}u;
+        size_t cut = 0u, k = 0u;
+        inner = n - {s + e}u;
+        own = 1;
+        while (cut < inner && t[cut] != {_byte(layout.separator)}) {{
+            cut++;
+        }}
+        talker = cut < {t.talker}u ? cut : {t.talker}u;
+        for (k = 0u; k < talker; k++) {{
+            out->talker[k] = (char)t[k];
+        }}
+        out->talker[talker] = '\\0';
+        kind = {p}__lookup(t + talker, cut - talker, dir);
+        if (kind == {P}_KIND_NONE || !({kinds})) {{
+            return {P}_E_UNKNOWN; /* no message of this text */
+        }}
+        c.b = t + (cut < inner ? cut + 1u : inner);
+        c.n = cut < inner ? inner - cut - 1u : 0u;
+        c.pos = 0u;
+        c.more = cut < inner;
+        c.sep = {_byte(layout.separator)};
+        c.list = {_byte(layout.list or layout.separator)};
+        seps = cut < inner ? 1u : 0u;
+        for (k = 0u; k < c.n; k++) {{
+            if (c.b[k] == c.sep || c.b[k] == c.list) {{
+                seps++;
+            }}
+        }}
+        out->sent = -1;
+    }}
+""")
+        inner = "\n".join("    " + line if line else line for line in "".join(reads).split("\n"))
+        read = "    {\n        size_t at = 0u, inner = 0u;\n" + inner + "    }\n"
+        writes = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n"
+            f"        {self.call('put_text')}(o, {_c_string(m.layout.start)}, {len(m.layout.start)}u);\n        break;"
+            for m in t.messages
+            if m.layout is not None and m.layout.start
+        )
+        write = (
+            f"    switch (msg->kind) {{ /* a message's own start, before the talker */\n{writes}\n"
+            "    default:\n        break;\n    }\n"
+        )
+        return "    int own = 0; /* a frame in a message's own text with a start */\n" + read, write
+
     def alone_decode(self) -> tuple[str, str, str]:
         """Messages in their own layout, found by their code alone (an ELM327's reply `41 0C 1A F8 `, an AT modem's
         `+CSQ: 20,99`; runtime/text.py TextFraming._decode_alone), tried where the frame's first field is no code of
         a message of `dir` in the framing's own text: the helper before the decoder, the decoder's reading of one,
         and the test of the kinds whose frames are written in their own layout (encode ignores `sent` there)."""
         p, P, t = self.p, self.P, self.text
-        alone = sorted((m for m in t.messages if m.layout is not None), key=lambda m: -len(m.code))
-        own_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in alone) or "0"
+        own_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in t.messages if m.layout) or "0"
+        found = [m for m in t.messages if m.layout is not None and not m.layout.start]  # by their code alone
+        alone = sorted(found, key=lambda m: -len(m.code))
         if not alone:
             return "", "", own_kinds
         plain = [m for m in t.messages if m.layout is None and not m.values_only]
@@ -818,6 +882,7 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
         alone_helpers, alone_read, own_kinds = self.alone_decode()
         address_read, address_write, address_set = self.address()
+        start_read, start_write = self.framed()
         address_decl = "    size_t digits = 0u;\n    int64_t number = 0;\n" if address_read else ""
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}
@@ -918,6 +983,9 @@ static int {p}__special(uint8_t c)
         separated_dirs = f"({separated_dirs})" if separated_dirs else "0"
         separated_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in separated) or "0"
         bare_helpers, bare_read, bare_write, expect_reply = self.bare_decode(bare)
+        if start_read:  # a frame in a layout with a start is read as it, nothing else
+            alone_read = alone_read.replace(f"    if (!{p}__plain(", f"    if (!own && !{p}__plain(", 1)
+            bare_read = bare_read.replace("    if (reply != ", "    if (!own && reply != ", 1)
         talker_write_bare = talker_write
         if bare and talker_write:  # a reply of values alone: no talker written
             talker_write_bare = f"    if (!{P}__BARE(msg->kind)) {{\n{talker_write}\n    }}"
@@ -1055,7 +1123,7 @@ static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir,
     c.pos = address < n ? address + 1u : n;
     c.sep = {P}__SEPARATOR;
     c.list = {P}__SEPARATOR;
-{alone_read}{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+{start_read}{alone_read}{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
         return {P}_E_UNKNOWN;
     }}
     out->unchecked = unchecked != 0;
@@ -1098,7 +1166,7 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 /* Address, talker, code and fields (range-checked when `check`), from o's position on. */
 static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
 {{
-{address_write}{talker_write_bare}
+{address_write}{start_write}{talker_write_bare}
     switch (msg->kind) {{
 {enc_cases}
     case {P}_KIND_NONE:
@@ -1289,7 +1357,7 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
                     if text.talker
                     else "    c.pos = 0u;\n"
                 )
-                + f"    c.pos += {'lead + ' if text.address else ''}{len(m.code) + len(after)}u;\n"
+                + f"    c.pos += {'lead + ' if text.address else ''}{len(layout.start) + len(m.code) + len(after)}u;\n"
                 + (f"    c.n = len >= {len(layout.end)}u ? len - {len(layout.end)}u : 0u;\n" if layout.end else "")
                 + f"    c.pos = c.pos < c.n ? c.pos : c.n;\n"
                 f"    c.sep = {_byte(layout.separator)};\n    c.list = {_byte(layout.list or layout.separator)};\n"

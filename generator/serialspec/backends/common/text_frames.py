@@ -47,8 +47,8 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a reply under a code of its own (`text: {code: ...}`)")
     if any(m.layout is not None for m in text.messages) and "layouts" not in takes:
         raise Unsupported("a message's own text layout (`text:`)")
-    if any(m.layout is not None and (m.layout.start or m.layout.labelled) for m in text.messages):
-        raise Unsupported("a message's own text with a start or labels (`text: {start: ...}`, `text: {named: ...}`)")
+    if any(m.layout is not None and m.layout.labelled for m in text.messages):
+        raise Unsupported("a message's own text with labels (`text: {named: ...}`)")
     # (a target that reads each line alone: a line of values names no message)
     if any(m.values_only for m in text.messages) and "values_only" not in takes:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")

@@ -68,9 +68,6 @@ def _sent(m: TextMessage) -> list[TextField | TextRepeat]:
     return [f for f in m.fields if not (isinstance(f, TextField) and f.address)]
 
 
-_SENT = _sent
-
-
 class TextC:
     """One text protocol's C."""
 
@@ -342,7 +339,7 @@ const char *{p}_result_name(int result);
         p, P = self.p, self.P
         lines: list[str] = []
         at = 0
-        for item in _SENT(m):
+        for item in _sent(m):
             if isinstance(item, TextField):
                 lines.append(self.read(item, "m->"))
                 at += 1
@@ -472,7 +469,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         t = self.text
         if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
             own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
-        for item in _SENT(m):
+        for item in _sent(m):
             if isinstance(item, TextField):
                 checks.append(self.check(item, "m->", own, rest_own))
                 writes.append(self.write(item, "m->", part))

@@ -32,13 +32,65 @@ from test_text_frames import sentence_values
 pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
 
 MATRIX = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_matrix"}
-MATRIX["framing"]["end"] = "\xff\xff\xff"  # a line ending of bytes above 0x7F (Nextion's FF FF FF)
-# frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), ended by CR LF; an
+# a line ending of bytes above 0x7F (Nextion's FF FF FF) for requests, and one of their own for responses (an
+# ELM327's CR CR `>`, here LF LF `>`)
+MATRIX["framing"]["end"] = {"request": "\xff\xff\xff", "response": "\n\n>"}
+# a start of its own for each direction (Lynxmotion LSS: `#` asks, `*` answers; here `$`)
+MATRIX["framing"]["start"] = {"request": "#", "response": "$"}
+# an address before the code, every message's first field (LSS's servo id: `#5QD`)
+MATRIX["framing"]["address"] = "unit"
+MATRIX["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
+# a checksum in requests only (G-code's numbered lines carry one, the firmware's replies none: a `!` in them is text)
+MATRIX["framing"]["checksum"]["directions"] = ["request"]
+# messages in their own text found by their code alone: a reply under a code of its own of two words, a value glued to
+# its code beside a longer code it begins (LSS's `D1800`), and a separator and list of their own
+MATRIX["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
+MATRIX["commands"] |= {
+    "glued": {
+        "code": "GL",
+        "response": {"unsolicited": True, "text": {"after_code": ""}, "fields": {"n": {"type": "integer"}}},
+    },
+    "longer": {"code": "GLX", "response": {"unsolicited": True, "fields": {"v": "integer"}}},
+    # a message's own text with a start and end (GRBL's `[MSG:...]`, `[GC:...]`), two messages sharing it
+    "bracket": {
+        "code": "MSG",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "[", "end": "]", "separator": ":"},
+            "fields": {
+                "a": "integer",
+                "t": "text",
+                "r": {"type": "repeat", "max_count": 2, "fields": {"x": "integer"}},
+            },
+        },
+    },
+    "bracket2": {
+        "code": "GC",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "[", "end": "]", "separator": ":"},
+            "fields": {"b": "integer"},
+        },
+    },
+    "pairs": {
+        "code": "PR",
+        "response": {
+            "unsolicited": True,
+            "text": {"separator": "=", "list": ":"},
+            "fields": {
+                "vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}},
+                "more": {"type": "repeat", "max_count": 2, "fields": {"w": "integer", "t": "text"}},
+            },
+        },
+    },
+}
+# frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), requests ended by
+# CR LF, responses by CR CR `>` (an ELM327's); an
 # optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`); a reply of
 # values alone, read as the reply awaited
 LINES = copy.deepcopy(TEXT_CASE) | {"protocol": "c_text_lines"}
 del LINES["framing"]["start"]
-LINES["framing"]["end"] = "\r\n"
+LINES["framing"]["end"] = {"request": "\r\n", "response": "\r\r>"}  # an ELM327's reply ends with CR CR `>`
 LINES["framing"]["checksum"] = {
     "algorithm": "xor",
     "format": "decimal",
@@ -47,6 +99,40 @@ LINES["framing"]["checksum"] = {
     "separated": ["request"],
 }
 LINES["commands"]["dial"]["response"]["values_only"] = True  # ODrive's `r vbus_voltage` answered `24.1`
+# a text to the end of the line (`size: rest`: Marlin's `Error:checksum mismatch, Last Line: 122`), separators and all,
+# in a plain message (both cases) and in one found by its code (`ER=...`)
+NOTE = {
+    "code": "NT",
+    "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
+}
+MATRIX["commands"]["note"] = LINES["commands"]["note"] = NOTE
+MATRIX["commands"]["error"] = {
+    "code": "ER",
+    "response": {"unsolicited": True, "text": {"after_code": "="}, "fields": {"msg": {"type": "text", "size": "rest"}}},
+}
+# replies under codes of their own: an AT modem's `+CSQ: 20,99` and an ELM327's `41 0C 1A F8 ` (here `;` between words)
+LINES["commands"] |= {
+    "signal": {
+        "code": "SQ",
+        "request": {"fields": {}},
+        "response": {
+            "text": {"code": "+SQ:", "after_code": " "},
+            "fields": {"rssi": {"type": "integer", "range": [0, 99]}, "ber": {"type": "integer", "range": [0, 99]}},
+        },
+    },
+    "rpm": {
+        "code": "RPM",
+        "request": {"fields": {}},
+        "response": {
+            "text": {"code": "41;0C", "end": " "},
+            "fields": {
+                "a": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                "b": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
+                "note": "text",
+            },
+        },
+    },
+}
 CASES = {"c_text_matrix": MATRIX, "c_text_lines": LINES}
 SPECS = {
     "nmea0183": ROOT / "specs" / "nmea0183.yaml",
@@ -220,7 +306,7 @@ def stream_agrees(
     at = 0
     for frame in (bytes.fromhex(a[6:]) for a in answers if a.startswith("frame ")):
         found = stream.find(frame, at)
-        assert found >= 0 and frame.startswith(b.framing.start.encode()), (frame, stream)
+        assert found >= 0 and frame.startswith(b.framing.start_of(direction).encode()), (frame, stream)
         at = found + len(frame)
 
 
@@ -231,14 +317,29 @@ def messages_of(b: Built) -> list[tuple[str, TextSentence]]:
 def frames(b: Built, direction: str) -> st.SearchStrategy[bytes]:
     """Valid frames of the direction's messages, encoded by runtime/text.py, with any of the spec's talkers."""
     talkers = b.framing.talkers or ("X" * b.framing.talker,)
+
+    def encoded(s: TextSentence, values: dict[str, Any], talker: str) -> bytes | None:
+        try:
+            return b.framing.encode(s.code, values, talker, direction=s.direction)
+        except EncodeError:  # a text holding a character of the framing's (a line ending's `>`)
+            return None
+
     choices = [
-        st.tuples(sentence_values(s), st.sampled_from(talkers)).map(
-            lambda x, s=s: b.framing.encode(s.code, x[0], x[1], direction=s.direction)
-        )
+        st.tuples(values_of(s), st.sampled_from(talkers)).map(lambda x, s=s: encoded(s, *x))
         for s in b.framing.sentences
         if s.direction == direction
     ]
-    return st.one_of(choices)
+    return st.one_of(choices).filter(lambda frame: frame is not None)  # type: ignore[arg-type]
+
+
+def values_of(sentence: TextSentence) -> st.SearchStrategy[dict[str, Any]]:
+    """A message's values (test_text_frames.sentence_values), a text to the end of the line holding the separator
+    and a message's own characters too."""
+    rest = [f for f in sentence.fields if isinstance(f, TextField) and f.rest]
+    if not rest:
+        return sentence_values(sentence)
+    text = st.one_of(st.none(), st.text(st.sampled_from("ab =;:1"), min_size=1))
+    return st.tuples(sentence_values(sentence), text).map(lambda x: {**x[0], rest[0].name: x[1]})
 
 
 def directions(b: Built) -> list[str]:
@@ -286,8 +387,9 @@ def test_every_example_decodes_to_the_spec_texts_and_encodes_back(name: str) -> 
     assert text.examples or name == "c_text_matrix"
     for example in text.examples:
         frame = example.printed.encode("ascii")
-        frame += b"" if frame.endswith(b.framing.end.encode("latin-1")) else b.framing.end.encode("latin-1")
         direction = example.direction.value
+        ending = b.framing.end_of(direction).encode("latin-1")
+        frame += b"" if frame.endswith(ending) else ending
         (answer,) = driver(name).ask(f"dec {direction} {frame.hex()}")
         assert answer.startswith("ok "), (example.name, answer)
         got = json.loads(answer[3:])
@@ -305,6 +407,7 @@ def test_random_messages_and_mutated_frames_decode_and_encode_as_python_does(nam
     def agree(case: tuple[str, bytes], data: st.DataObject) -> None:
         direction, frame = case
         check_decode(b, frame, direction)
+        check_decode(b, frame, "response" if direction == "request" else "request")  # read as the other direction
         awaited = bare(b)
         if awaited is not None and direction == awaited.direction:  # read as the reply of values alone awaited
             check_decode(b, frame, direction, expect=awaited)
@@ -322,6 +425,8 @@ def test_random_messages_and_mutated_frames_decode_and_encode_as_python_does(nam
 def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(name: str) -> None:
     b = built(name)
     start, end = b.framing.start.encode(), b.framing.end.encode("latin-1")
+    other = b.framing.response_end.encode("latin-1")  # the responses' own line ending, where they have one
+    answer = b.framing.response_start.encode()  # the responses' own start, where they have one
 
     @settings(max_examples=examples(25), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(directions(b)), st.data())
@@ -336,7 +441,7 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
                 )
             ),  # fmt: skip
             st.binary(max_size=6),
-            st.sampled_from([start, end, start + b"X" * (b.framing.max_length + 3), b"\r", b"\n"]),
+            st.sampled_from([start, end, other, answer, start + b"X" * (b.framing.max_length + 3), b"\r", b"\n"]),
         )
         stream = b"".join(data.draw(st.lists(piece, max_size=8)))
         sizes = data.draw(st.lists(st.integers(0, 9), min_size=1, max_size=6))

@@ -2021,23 +2021,27 @@ def test_every_text_alternative_through_every_output(tmp_path: Path) -> None:
         assert package.FRAMING.decode(b"#AEV;;;0a3f;-FA" + hexed[15:]).values["lx"] == -250
 
 
-def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output() -> None:
+def test_line_ends_by_direction_and_a_reply_code_of_its_own_through_every_output(tmp_path: Path) -> None:
     """`end: {request: ..., response: ...}` and a response's `text: {code: ...}` of several words (an ELM327's `010C`
-    answered `41 0C 1A F8 ` and CR CR `>`): C refuses each in one line (tests/test_wireshark_text.py holds the dissector
-    to decode); the reference says both; each direction ends with its own; the reply is found by its own code, the
-    simulator answers with it and the codec pairs it with its request; random messages round trip, all in one stream of
-    both directions read byte by byte; misuse (and of `base`, `case`) refused one line each."""
+    answered `41 0C 1A F8 ` and CR CR `>`): every output takes both (the C compiles; tests/test_c_text.py and
+    tests/test_wireshark_text.py hold the C and the dissector to Python); the reference says both; each direction ends
+    with its own; the reply is found by its own code, the simulator answers with it and the codec pairs it with its
+    request; random messages round trip, all in one stream of both directions read byte by byte; misuse (and of `base`,
+    `case`) refused one line each."""
 
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["end"] = {"request": "\n", "response": "\n\n>"}
     case["commands"]["dial"]["response"]["text"] = {"code": "RE;DL"}
-    files = python_and_markdown(case, {"c": r"^a line ending of its own for each direction \(`end: \{request: \.\.\."})
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
+    source = files["matrix_text/matrix_text.c"]
+    assert "matrix_text__response_end[] = {0x0Au, 0x0Au, 0x3Eu, 0x00u}" in source and '"RE\\073DL"' in source
     docs = files["docs/matrix_text.md"]
     assert "| end | LF (requests), LF LF > (responses) |" in docs
     assert "`DialResponse`, a response, under a code of its own (its request's is `DL`)" in docs
     own_code = copy.deepcopy(case)
     own_code["framing"]["end"] = "\n"
-    python_and_markdown(own_code, {"c": r"^a reply under a code of its own \(`text: \{code: \.\.\.\}`\)$"})
+    python_and_markdown(own_code, {})
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         asked = package.DialRequest(talker="A", level=7, note="hi")
@@ -2182,7 +2186,7 @@ def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> Non
     files: dict[str, str] = {}
     for emitter in emitters():
         if emitter.name == "c":
-            with pytest.raises(Unsupported, match=r"^a message's own text layout \(`text:`\)$"):
+            with pytest.raises(Unsupported, match=r"^a message's own text with labels \(`text: \{named: "):
                 emitter.files(protocol)
             continue
         emitted = emit(emitter, protocol)
@@ -2295,12 +2299,12 @@ def test_a_decimal_text_checksum_through_every_output() -> None:
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
 
 
-def test_messages_found_by_their_code_alone_through_every_output() -> None:
+def test_messages_found_by_their_code_alone_through_every_output(tmp_path: Path) -> None:
     """A message's own `text:` without a `start` (found by its code: Roboteq's `A=12:13`) and with `after_code` (`""`:
-    the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins: C refuses
-    it in one line (tests/test_wireshark_text.py holds the dissector to decode); the reference says how it is written;
-    random messages round trip and are found byte by byte among the others; codes that a frame could not tell apart are
-    refused, one line each."""
+    the value glued to the code, LSS's `D1800`) beside plain sentences and a longer code the glued one begins: every
+    output takes it (the C compiles; tests/test_c_text.py and tests/test_wireshark_text.py hold the C and the dissector
+    to Python); the reference says how it is written; random messages round trip and are found byte by byte among the
+    others; codes that a frame could not tell apart are refused, one line each."""
 
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["glued"] = {
@@ -2316,7 +2320,8 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
             "fields": {"vals": {"type": "repeat", "count": 2, "fields": {"v": "integer"}}},
         },
     }
-    files = python_and_markdown(case, {"c": r"^a message's own text layout \(`text:`\)$"})
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
     docs = files["docs/matrix_text.md"]
     assert "found by its code: the code, the first field right after the code" in docs, docs
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
@@ -2348,14 +2353,15 @@ def test_messages_found_by_their_code_alone_through_every_output() -> None:
         assert len(lines) == 1 and expected in lines[0] and lines[0].startswith("matrix_text.yaml:"), lines
 
 
-def test_a_text_checksum_in_one_direction_through_every_output() -> None:
-    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): C refuses it
-    in one line (tests/test_wireshark_text.py holds the dissector to decode); requests carry the checksum, responses
-    none (a marker in one is text), with or without the direction given; random messages round trip, through the stream
-    parser too."""
+def test_a_text_checksum_in_one_direction_through_every_output(tmp_path: Path) -> None:
+    """`checksum: {directions: [request]}` (G-code: numbered lines carry one, the firmware's replies none): every output
+    takes it (the C compiles; tests/test_c_text.py and tests/test_wireshark_text.py hold the C and the dissector to
+    Python); requests carry the checksum, responses none (a marker in one is text), with or without the direction given;
+    random messages round trip, through the stream parser too."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["checksum"]["directions"] = ["request"]
-    files = python_and_markdown(case, {"c": r"^a text checksum in one direction only \(`checksum.directions`\)$"})
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
     assert "; requests only |" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2405,19 +2411,20 @@ def test_an_optional_text_checksum_after_a_separator_through_every_output() -> N
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
 
 
-def test_starts_by_direction_and_an_address_before_the_code_through_every_output() -> None:
-    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): C refuses the
-    starts in one line (tests/test_wireshark_text.py holds the dissector to decode); the reference shows both starts;
-    the start says the direction; every message carries the address first, its digits before the talker and code; random
-    messages round trip, among each other in a stream of both directions; the simulator answers with the request's
-    address."""
+def test_starts_by_direction_and_an_address_before_the_code_through_every_output(tmp_path: Path) -> None:
+    """`start: {request: "#", response: "$"}` and `address: unit` (Lynxmotion LSS's `#5QD` / `*5QD1800`): every output
+    takes both (the C compiles; tests/test_c_text.py and tests/test_wireshark_text.py hold the C and the dissector to
+    Python); the reference shows both starts; the start says the direction; every message carries the address first, its
+    digits before the talker and code; random messages round trip, among each other in a stream of both directions; the
+    simulator answers with the request's address."""
     case = copy.deepcopy(TEXT_CASE)
     case["framing"]["start"] = {"request": "#", "response": "$"}
     case["framing"]["address"] = "unit"
     case["fields"]["unit"] = {"type": "integer", "range": [0, 254]}
-    files = python_and_markdown(
-        case, {"c": r"^a start of its own for each direction \(`start: \{request: \.\.\., response"}
-    )
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
+    source = files["matrix_text/matrix_text.c"]
+    assert "#define MATRIX_TEXT__RESPONSE_START 0x24u" in source and "the address: the digits right" in source
     assert "| start | `#` or `$` | starts a request or a response |" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2445,9 +2452,9 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
 
 def test_labels_glued_to_their_values_through_every_output() -> None:
     """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's `D1800T1500`, the
-    first value labelled with the code): C refuses them in one line (tests/test_wireshark_text.py holds the dissector to
-    decode); the reference says how they are written; random messages round trip and stream; what a frame could not tell
-    apart is refused."""
+    first value labelled with the code): the C refuses them in one line (labels: it takes a message's own text without
+    them), the dissector reads them (tests/test_wireshark_text.py holds it to decode); the reference says how they are
+    written; random messages round trip and stream; what a frame could not tell apart is refused."""
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["move"] = {
         "code": "MV",
@@ -2469,7 +2476,7 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
             "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
         },
     }
-    files = python_and_markdown(case, {"c": r"^a message's own text layout \(`text:`\)$"})
+    files = python_and_markdown(case, {"c": r"^a message's own text with labels \(`text: \{named: "})
     assert "written as its label glued to its value" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
@@ -2496,11 +2503,11 @@ def test_labels_glued_to_their_values_through_every_output() -> None:
         resolve(load_text(yaml.safe_dump(broken, sort_keys=False), "matrix_text.yaml"))
 
 
-def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
+def test_a_text_to_the_end_of_the_line_through_every_output(tmp_path: Path) -> None:
     """A `text` field's `size: rest` (Marlin's `Error:checksum mismatch, Last Line: 122`): the rest of the line,
-    separators included, in a plain message and in one found by its code; C refuses it in one line
-    (tests/test_wireshark_text.py holds the dissector to decode); the reference says so; round trips, with separators
-    and the layout's own characters in the text; misplaced, refused."""
+    separators included, in a plain message and in one found by its code: every output takes it (the C compiles;
+    tests/test_c_text.py and tests/test_wireshark_text.py hold the C and the dissector to Python); the reference says
+    so; round trips, with separators and the layout's own characters in the text; misplaced, refused."""
     case = copy.deepcopy(TEXT_CASE)
     case["commands"]["note"] = {
         "code": "NT",
@@ -2514,7 +2521,8 @@ def test_a_text_to_the_end_of_the_line_through_every_output() -> None:
             "fields": {"msg": {"type": "text", "size": "rest"}},
         },
     }
-    files = python_and_markdown(case, {"c": r"^a text field to the end of the line \(`size: rest`\)$"})
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
     assert "text (the rest of the line, separators included)" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

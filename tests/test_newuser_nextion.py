@@ -45,23 +45,21 @@ def test_the_cli_encodes_and_decodes_them() -> None:
     assert lines[0] == "70 61 67 65 20 31 ff ff ff" and "dim" in lines[1], lines
 
 
-def test_the_dissector_refuses_such_a_line_ending_and_the_c_target_takes_it() -> None:
-    """The C reads a line ending above 0x7F (tests/test_c_text.py holds it to Python); it refuses the spec for its
-    replies' own text layouts (`text:`), which it does not generate yet."""
-    from serialspec.backends import Unsupported, emitters
+def test_the_c_target_and_the_dissector_take_such_a_line_ending() -> None:
+    """The C and the Wireshark dissector read a line ending above 0x7F and messages in their own text found by their
+    code (`page 1`, `dim=50`; tests/test_c_text.py and tests/test_wireshark_text.py hold both to Python): each
+    generates the spec."""
+    from serialspec.backends import emitters
     from serialspec.lang.loader import load_text
     from serialspec.lang.resolve import resolve
 
     text = SPEC.read_text("utf-8").replace("  separator:", '  start: "%"\n  separator:')
     protocol = resolve(load_text(text, "nextion.yaml"))
-    said = {
-        "wireshark": r"^a line ending with bytes above 0x7F \(`end`\)$",
-        "c": r"^a message's own text layout \(`text:`\)$",
-    }
     for emitter in emitters():
-        if emitter.name in said:
-            with pytest.raises(Unsupported, match=said[emitter.name]):
-                emitter.files(protocol)
+        if emitter.name == "c":
+            assert "nextion/nextion.c" in emitter.files(protocol)
+        elif emitter.name == "wireshark":
+            assert "nextion/nextion.lua" in emitter.files(protocol)
 
 
 @pytest.mark.xfail(

@@ -16,19 +16,27 @@
 /* ---- the frame, as the spec says (`$`, the talker id and the sentence id (GPGGA), each field after a comma, then `*` and the XOR of every character between `$` and `*` as two upper-case hex digits, then CR LF; at most 82 characters (gpsd: "NMEA Revealed"). NMEA 0183 makes the checksum optional for some sentences, so a sentence without one is accepted unchecked.) ---- */
 #define NMEA0183__S 1u /* the start character's bytes: 1, or 0 where every line is a frame */
 #define NMEA0183__START 0x24u /* '$' */
+#define NMEA0183__START_OF(dir) NMEA0183__START
+#define NMEA0183__IS_START(c) ((c) == NMEA0183__START)
 #define NMEA0183__SEPARATOR 0x2Cu    /* ',' */
 #define NMEA0183__MARKER 0x2Au          /* '*': the checksum follows */
 #define NMEA0183__CHECKED 1            /* a checksum is written */
+#define NMEA0183__CHECKS(dir) 1 /* the frames of `dir` carry it */
+#define NMEA0183__AGAIN (-1) /* p__decode_in: read it again as the other direction's (no checksum) */
 #define NMEA0183__REQUIRED 0        /* a frame without one is refused */
 #define NMEA0183__DIGITS 2u                /* hex digits of the checksum */
 #define NMEA0183__SEPARATED(dir) 0 /* a separator before the marker */
-#define NMEA0183__LIMIT 84u /* the parser drops a line longer than this without its line ending */
+/* the parser drops a line longer than this without its line ending */
+#define NMEA0183__LIMIT(dir) (82u + NMEA0183__END_LEN(dir))
 #define NMEA0183__REPLY(p) NMEA0183_KIND_NONE
 #define NMEA0183__ANSWERED(p, out) ((void)0)
 #define NMEA0183__INIT_REPLY(p) ((void)0)
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_ENCODE || NMEA0183_ENABLE_PARSER
 static const uint8_t nmea0183__end[] = {0x0Du, 0x0Au, 0x00u}; /* '\r\n', the line ending */
+#define NMEA0183__END(dir) nmea0183__end
+#define NMEA0183__END_LEN(dir) (sizeof(nmea0183__end) - 1u)
 #endif
+#define NMEA0183__OTHER(dir) ((dir) == NMEA0183_REQUEST ? NMEA0183_RESPONSE : NMEA0183_REQUEST)
 
 #if NMEA0183_ENABLE_DECODE || NMEA0183_ENABLE_PARSER
 /* 1 when a[0..n) and b[0..n) hold the same bytes */
@@ -101,12 +109,15 @@ static int nmea0183__digit(uint8_t c)
 }
 #endif
 
-/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
+/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last; sep and
+ * list end a field (the framing's separator, or a message's own separator and list character). */
 typedef struct {
     const uint8_t *b;
     size_t n;
     size_t pos;
     int more;
+    uint8_t sep;
+    uint8_t list;
 } nmea0183__cursor_t;
 
 #if NMEA0183_ENABLE_DECODE
@@ -119,7 +130,7 @@ static void nmea0183__next(nmea0183__cursor_t *c, size_t *start, size_t *len)
         *len = 0u;
         return;
     }
-    while (i < c->n && c->b[i] != NMEA0183__SEPARATOR) {
+    while (i < c->n && c->b[i] != c->sep && c->b[i] != c->list) {
         i++;
     }
     *start = c->pos;
@@ -313,7 +324,8 @@ typedef struct {
     uint8_t *b;
     size_t cap;
     size_t n;
-    int full; /* something did not fit */
+    int full;    /* something did not fit */
+    size_t rest; /* where a text to the end of the line begins (0: none; the separators in it are its own) */
 } nmea0183__out_t;
 
 static void nmea0183__put(nmea0183__out_t *o, uint8_t c)
@@ -473,30 +485,36 @@ static int nmea0183__hex_value(uint8_t c)
     return -1;
 }
 
-/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; NMEA0183_E_FRAME,
- * NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
- * separator before the marker, it is no part of the fields. */
-static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, size_t *body, size_t *n, int *unchecked)
+/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked where `check`;
+ * NMEA0183_E_FRAME, NMEA0183_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: the line ending
+ * taken off; where its frames write the separator before the marker, it is no part of the fields. */
+static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t dir, int check, size_t *body, size_t *n,
+                        int *unchecked)
 {
-    size_t i, end = len, stop;
+    size_t i, end = len, stop, ascii, own = NMEA0183__END_LEN(dir), other = NMEA0183__END_LEN(NMEA0183__OTHER(dir));
     *unchecked = 0;
     (void)dir;
-    if (len >= sizeof(nmea0183__end) - 1u && nmea0183__same(f + len - (sizeof(nmea0183__end) - 1u), nmea0183__end, sizeof(nmea0183__end) - 1u)) {
-        end = len - (sizeof(nmea0183__end) - 1u);
+    (void)check;
+    if (len >= own && nmea0183__same(f + len - own, NMEA0183__END(dir), own)) {
+        end = len - own; /* the direction's line ending */
     }
-    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
+    ascii = end; /* before the longest line ending of either direction the frame ends with */
+    if (len >= other && other > len - end && nmea0183__same(f + len - other, NMEA0183__END(NMEA0183__OTHER(dir)), other)) {
+        ascii = len - other;
+    }
+    for (i = 0u; i < ascii; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return NMEA0183_E_FRAME; /* a non-ASCII byte */
         }
     }
 #if NMEA0183__S
-    if (end < 1u || f[0] != NMEA0183__START) {
+    if (end < 1u || f[0] != NMEA0183__START_OF(dir)) { /* the direction's start */
         return NMEA0183_E_FRAME;
     }
 #endif
     stop = end;
 #if NMEA0183__CHECKED
-    {
+    if (check) {
         size_t at = end, k;
         uint32_t written = 0u;
         while (at > NMEA0183__S && f[at - 1u] != NMEA0183__MARKER) {
@@ -535,18 +553,19 @@ static int nmea0183__unframe(const uint8_t *f, size_t len, nmea0183_direction_t 
 
 #if NMEA0183_ENABLE_ENCODE
 /* Exactly `sent` fields after the address (o->b[NMEA0183__S..n): the address, then each field after a separator): the fields
- * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. */
+ * after the last one sent must be empty (NMEA0183_E_LENGTH), missing ones are written empty. A text to the end of the line
+ * (from o->rest on) is one field, the separators in it its own. */
 static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 {
-    size_t i, k, fields = 0u;
-    for (i = NMEA0183__S; i < o->n; i++) {
+    size_t i, k, fields = 0u, rest = o->rest > 0u ? o->rest : o->n;
+    for (i = NMEA0183__S; i < rest; i++) {
         if (o->b[i] == NMEA0183__SEPARATOR && ++fields > sent) {
             break;
         }
     }
     if (fields > sent) {
         for (k = i; k < o->n; k++) {
-            if (o->b[k] != NMEA0183__SEPARATOR) {
+            if (o->b[k] != NMEA0183__SEPARATOR || k >= rest) {
                 return NMEA0183_E_LENGTH; /* a field after the last one sent has a value */
             }
         }
@@ -561,16 +580,17 @@ static int nmea0183__trim(nmea0183__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[NMEA0183__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated)
+static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int separated, nmea0183_direction_t dir)
 {
     size_t k;
     (void)separated;
+    (void)dir;
 #if NMEA0183__S
-    o->b[0] = NMEA0183__START;
+    o->b[0] = NMEA0183__START_OF(dir);
 #endif
     (void)unchecked;
 #if NMEA0183__CHECKED
-    if (!unchecked || NMEA0183__REQUIRED) {
+    if ((!unchecked || NMEA0183__REQUIRED) && NMEA0183__CHECKS(dir)) {
         uint32_t sum;
         if (separated) { /* the separator before the marker, covered by the checksum */
             nmea0183__put(o, NMEA0183__SEPARATOR);
@@ -583,8 +603,8 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
         }
     }
 #endif
-    for (k = 0u; k + 1u < sizeof(nmea0183__end); k++) {
-        nmea0183__put(o, nmea0183__end[k]);
+    for (k = 0u; k < NMEA0183__END_LEN(dir); k++) {
+        nmea0183__put(o, NMEA0183__END(dir)[k]);
     }
     if (o->full) {
         return NMEA0183_E_BUFFER;
@@ -594,6 +614,23 @@ static int nmea0183__frame(nmea0183__out_t *o, size_t *len, bool unchecked, int 
 }
 #endif
 
+
+#if NMEA0183_ENABLE_ENCODE || (NMEA0183_ENABLE_DECODE && 0)
+/* The direction of a message of `kind`. */
+static nmea0183_direction_t nmea0183__direction(nmea0183_kind_t kind)
+{
+    switch (kind) {
+    case NMEA0183_GGA_RESPONSE:
+    case NMEA0183_RMC_RESPONSE:
+    case NMEA0183_VTG_RESPONSE:
+    case NMEA0183_GSA_RESPONSE:
+    case NMEA0183_GSV_RESPONSE:
+        return NMEA0183_RESPONSE;
+    default:
+        return NMEA0183_REQUEST;
+    }
+}
+#endif
 
 #if NMEA0183_ENABLE_DECODE
 /* Global Positioning System Fix Data (GGA, response): each field in turn, an empty one absent. */
@@ -1131,11 +1168,14 @@ static nmea0183_kind_t nmea0183__lookup(const uint8_t *code, size_t n, nmea0183_
     return NMEA0183_KIND_NONE;
 }
 
-/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's first field is
- * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
-static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
-                       nmea0183_msg_t *out)
+/* `reply`: a reply of values alone awaited (NMEA0183_KIND_NONE: none), read where the frame's
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). `again`: a frame of the other
+ * direction's (its line ending taken off), read as `dir`, which carries no checksum. */
+static int nmea0183__decode_in(const uint8_t *frame, size_t len, nmea0183_direction_t dir, int again, nmea0183_kind_t expect,
+                          nmea0183_kind_t reply, nmea0183_msg_t *out)
 {
+    const nmea0183_direction_t sent_as = again ? NMEA0183__OTHER(dir) : dir;
+
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     nmea0183__cursor_t c;
     nmea0183_kind_t kind;
@@ -1144,13 +1184,13 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
         return NMEA0183_E_ARG;
     }
     out->kind = NMEA0183_KIND_NONE;
-    if (!NMEA0183__DECODES(dir)) { /* the other side's direction, left out of this build */
+    if (!NMEA0183__DECODES(sent_as)) { /* the other side's direction, left out of this build */
         return NMEA0183_E_ARG;
     }
     if (len > NMEA0183_MAX_FRAME) {
         return NMEA0183_E_CAPACITY;
     }
-    r = nmea0183__unframe(frame, len, dir, &body, &n, &unchecked);
+    r = nmea0183__unframe(frame, len, sent_as, !again && NMEA0183__CHECKS(dir), &body, &n, &unchecked);
     if (r != NMEA0183_OK) {
         return r;
     }
@@ -1172,6 +1212,8 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
+    c.sep = NMEA0183__SEPARATOR;
+    c.list = NMEA0183__SEPARATOR;
     (void)reply;
     if (kind == NMEA0183_KIND_NONE || (expect != NMEA0183_KIND_NONE && expect != kind)) {
         return NMEA0183_E_UNKNOWN;
@@ -1209,6 +1251,16 @@ static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction
     return r;
 }
 
+static int nmea0183__decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_kind_t reply,
+                       nmea0183_msg_t *out)
+{
+    int r = nmea0183__decode_in(frame, len, dir, 0, expect, reply, out);
+    if (r == NMEA0183__AGAIN) { /* a code of the other direction alone: its frame is text to its end, the marker too */
+        r = nmea0183__decode_in(frame, len, NMEA0183__OTHER(dir), 1, expect, reply, out);
+    }
+    return r;
+}
+
 int nmea0183_decode_expect(const uint8_t *frame, size_t len, nmea0183_direction_t dir, nmea0183_kind_t expect, nmea0183_msg_t *out)
 {
     return nmea0183__decode(frame, len, dir, expect, NMEA0183_KIND_NONE, out);
@@ -1224,10 +1276,14 @@ int nmea0183_decode(const uint8_t *frame, size_t len, nmea0183_direction_t dir, 
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gga_response(const nmea0183_gga_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_utc && (!nmea0183__time_ok(&m->utc))) {
             return NMEA0183_E_RANGE;
@@ -1398,10 +1454,14 @@ static int nmea0183__enc_gga_response(const nmea0183_gga_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_rmc_response(const nmea0183_rmc_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_utc && (!nmea0183__time_ok(&m->utc))) {
             return NMEA0183_E_RANGE;
@@ -1546,10 +1606,14 @@ static int nmea0183__enc_rmc_response(const nmea0183_rmc_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_vtg_response(const nmea0183_vtg_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_course_true && (m->course_true.scale > 18u)) {
             return NMEA0183_E_RANGE;
@@ -1661,10 +1725,14 @@ static int nmea0183__enc_vtg_response(const nmea0183_vtg_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gsa_response(const nmea0183_gsa_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_selection && (m->selection != 'M' && m->selection != 'A')) {
             return NMEA0183_E_RANGE;
@@ -1747,10 +1815,14 @@ static int nmea0183__enc_gsa_response(const nmea0183_gsa_response_t *m, nmea0183
  * field after a separator, an absent one empty. */
 static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183__out_t *o, int check)
 {
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {
     if (m->has_sentences && (nmea0183__compare(m->sentences, 0u, 1, 0u) < 0)) {
             return NMEA0183_E_RANGE;
@@ -1833,7 +1905,7 @@ static int nmea0183__enc_gsv_response(const nmea0183_gsv_response_t *m, nmea0183
     return NMEA0183_OK;
 }
 
-/* Talker, code and fields (range-checked when `check`), from o's position on. */
+/* Address, talker, code and fields (range-checked when `check`), from o's position on. */
 static int nmea0183__body(const nmea0183_msg_t *msg, nmea0183__out_t *o, int check)
 {
     size_t i;
@@ -1889,6 +1961,7 @@ int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, si
     o.cap = cap;
     o.n = 0u;
     o.full = 0;
+    o.rest = 0u;
     r = nmea0183__body(msg, &o, 0);
     if (r == NMEA0183_OK && o.full) {
         r = NMEA0183_E_BUFFER;
@@ -1898,21 +1971,22 @@ int nmea0183_field_texts(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, si
 }
 
 #if NMEA0183_ENABLE_PARSER
-/* Where `c` is in b[from..n), n if nowhere. */
-static size_t nmea0183__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
+/* Where a start (of either direction) is in b[from..n), n if nowhere. */
+static size_t nmea0183__find(const uint8_t *b, size_t from, size_t n)
 {
-    while (from < n && b[from] != c) {
+    while (from < n && !NMEA0183__IS_START(b[from])) {
         from++;
     }
     return from;
 }
 
-/* Where the line ending is in b[from..n), n if nowhere. */
-static size_t nmea0183__find_end(const uint8_t *b, size_t from, size_t n)
+/* Where the line ending of `dir` is in b[from..n), n if nowhere. */
+static size_t nmea0183__find_end(const uint8_t *b, size_t from, size_t n, nmea0183_direction_t dir)
 {
-    size_t k = sizeof(nmea0183__end) - 1u;
+    size_t k = NMEA0183__END_LEN(dir);
+    (void)dir;
     for (; from + k <= n; from++) {
-        if (nmea0183__same(b + from, nmea0183__end, k)) {
+        if (nmea0183__same(b + from, NMEA0183__END(dir), k)) {
             return from;
         }
     }
@@ -1932,19 +2006,19 @@ static void nmea0183__drop(nmea0183_parser_t *p, size_t k)
  * than the spec's max_length, is dropped (counted in errors), as is one that does not decode. */
 static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *out)
 {
-    const size_t limit = NMEA0183__LIMIT, k = sizeof(nmea0183__end) - 1u;
-    if (p->n < NMEA0183__LIMIT + 1u) {
+    const size_t limit = NMEA0183__LIMIT(p->dir), k = NMEA0183__END_LEN(p->dir);
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
     for (;;) {
-        size_t start = nmea0183__find(p->buf, 0u, p->n, NMEA0183__START), end, restart;
+        size_t start = nmea0183__find(p->buf, 0u, p->n), end, restart;
         if (start == p->n) {
             p->n = 0u;
             return 0;
         }
         nmea0183__drop(p, start);
-        end = nmea0183__find_end(p->buf, 1u, p->n);
-        restart = nmea0183__find(p->buf, 1u, p->n, NMEA0183__START);
+        end = nmea0183__find_end(p->buf, 1u, p->n, p->dir);
+        restart = nmea0183__find(p->buf, 1u, p->n);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
                 p->errors++;
@@ -1981,7 +2055,7 @@ static int nmea0183__push(nmea0183_parser_t *p, uint8_t byte, nmea0183_msg_t *ou
 
 void nmea0183_parser_gap(nmea0183_parser_t *parser)
 {
-    if (parser->n > 0u) { /* it begins with the start character */
+    if (parser->n > 0u) { /* it begins with a start character */
         parser->errors++;
     }
     parser->n = 0u;
@@ -2054,11 +2128,13 @@ void nmea0183_parser_expect(nmea0183_parser_t *parser, nmea0183_kind_t reply)
 #endif
 
 #if NMEA0183_ENABLE_ENCODE
+
 int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {
     nmea0183__out_t o;
-    size_t i;
+    size_t i, at = 0u;
     int r;
+    (void)at;
     if (msg == NULL || buf == NULL || len == NULL) {
         return NMEA0183_E_ARG;
     }
@@ -2077,18 +2153,19 @@ int nmea0183_encode(const nmea0183_msg_t *msg, uint8_t *buf, size_t cap, size_t 
     o.cap = cap;
     o.n = NMEA0183__S;
     o.full = 0;
+    o.rest = 0u;
     r = nmea0183__body(msg, &o, 1);
     if (r != NMEA0183_OK) {
         return r;
     }
-    if (msg->sent >= 0 && !o.full) { /* as many fields as the sentence had */
+    if (msg->sent >= 0 && !o.full && !(0)) { /* as many fields as the sentence had */
         r = nmea0183__trim(&o, (size_t)msg->sent);
         if (r != NMEA0183_OK) {
             return r;
         }
     }
 
-    return nmea0183__frame(&o, len, msg->unchecked, 0);
+    return nmea0183__frame(&o, len, msg->unchecked, 0, nmea0183__direction(msg->kind));
 }
 #endif
 

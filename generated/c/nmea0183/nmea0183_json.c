@@ -52,17 +52,20 @@ static void nmea0183__j_text(nmea0183__json_t *j, const uint8_t *t, size_t n)
     nmea0183__j_char(j, '"');
 }
 
-/* The fields' texts one after another, as the frame has them after the address. */
+/* The fields' texts one after another, as the frame has them after the address, ended by sep or list (a message's
+ * own layout's). */
 typedef struct {
     const uint8_t *b;
     size_t n;
     size_t pos;
+    uint8_t sep;
+    uint8_t list;
 } nmea0183__jcur_t;
 
 static void nmea0183__j_field(nmea0183__json_t *j, nmea0183__jcur_t *c)
 {
     size_t start = c->pos;
-    while (c->pos < c->n && c->b[c->pos] != 0x2Cu) {
+    while (c->pos < c->n && c->b[c->pos] != c->sep && c->b[c->pos] != c->list) {
         c->pos++;
     }
     nmea0183__j_text(j, c->b + start, c->pos - start);
@@ -88,7 +91,8 @@ size_t nmea0183_to_json(const nmea0183_msg_t *msg, char *out, size_t cap)
     nmea0183__json_t j;
     nmea0183__jcur_t c;
     uint8_t body[NMEA0183__JSON_BODY];
-    size_t len = 0u, g = 0u;
+    size_t len = 0u, g = 0u, lead = 0u;
+    (void)lead;
     j.out = out;
     j.cap = cap;
     j.n = 0u;
@@ -99,7 +103,9 @@ size_t nmea0183_to_json(const nmea0183_msg_t *msg, char *out, size_t cap)
     c.b = body;
     c.n = len;
     c.pos = 0u;
-    while (c.pos < c.n && body[c.pos] != 0x2Cu) { /* the address: skipped */
+    c.sep = 0x2Cu;
+    c.list = 0x2Cu;
+    while (c.pos < c.n && body[c.pos] != 0x2Cu) { /* the talker and code: skipped */
         c.pos++;
     }
     if (c.pos < c.n) {

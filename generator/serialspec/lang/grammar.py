@@ -562,7 +562,7 @@ _FIELD_LONG: dict[str, Shape] = {
         "earlier integer fields, which stay in the message (`length - 2`: see `count`); array: the earlier "
         "field holding the array's size in bytes (Modbus byte_count). In text frames, a `text` field's `size: "
         "rest` is the rest of the line, separators included (a message's last field: Marlin's `Error:checksum "
-        "mismatch, Last Line: 122` as one text); the C target refuses it, saying so.",
+        "mismatch, Last Line: 122` as one text).",
     ),
     "count": OneOf(
         (Int(), Str()),
@@ -744,7 +744,7 @@ TEXT_LAYOUT = Obj(
             'own (an ELM327 answers `010C` with `41 0C 1A F8`: `response: {text: {code: "41 0C"}}`; an AT modem '
             'answers `AT+CSQ` with `+CSQ: 20,99`: `text: {code: "+CSQ:", after_code: " "}`). It may hold '
             "the message's separator (several words); the message is found by it, the longest code that fits, and "
-            "clients and the simulator pair it with its request as usual. The C target refuses it, saying so.",
+            "clients and the simulator pair it with its request as usual.",
             example="41 0C",
         ),
         "end": Str("What the message's text ends with, before the framing's own checksum and end (`>`).", example=">"),
@@ -778,7 +778,8 @@ TEXT_LAYOUT = Obj(
     },
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
-    "checksum and line end stay the framing's.",
+    "checksum and line end stay the framing's. The C target takes one whose fields have no labels; it refuses labels "
+    "(`named`), and the Wireshark dissector any `text:`, saying so.",
 )
 
 MESSAGE = Obj(
@@ -1542,8 +1543,7 @@ FRAMING = Obj(
             "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
             "line ending) and the stream parser resynchronises at the next line ending. A mapping gives each "
             'direction its own (Lynxmotion LSS: `start: {request: "#", response: "*"}`, `#5QD` asked and '
-            "`*5QD1800` answered): a frame's start then says its direction. The C target refuses starts that "
-            "differ by direction, saying so.",
+            "`*5QD1800` answered): a frame's start then says its direction.",
             example="$",
         ),
         "separator": Str("text: the character between fields.", example=","),
@@ -1561,8 +1561,7 @@ FRAMING = Obj(
             "text: the line ending that closes every frame. A mapping gives each direction its own (an ELM327 "
             'OBD-II adapter: `end: {request: "\\r", response: "\\r\\r>"}`, its reply ended by CR, a blank line '
             "and its `>` prompt): the stream parser of one direction waits for that direction's, and one reading "
-            "both takes the longest that ends a frame. The C target refuses line endings that differ by direction, "
-            "saying so.",
+            "both takes the longest that ends a frame.",
             example="\r\n",
         ),
         "checksum": Obj(
@@ -1600,8 +1599,7 @@ FRAMING = Obj(
                     Str(choices=("request", "response")),
                     "The directions whose frames carry it (default both): G-code's numbered lines carry one, the "
                     "firmware's `ok` and `Resend: 124` none (`directions: [request]`); a frame of the other "
-                    "direction is text to its end, the marker too. The C target refuses a checksum in one direction "
-                    "only, saying so.",
+                    "direction is text to its end, the marker too.",
                     example=["request"],
                 ),
             },
@@ -1627,7 +1625,7 @@ FRAMING = Obj(
             "text: a shared integer field (its name in `fields:`) that every message carries first, its digits "
             "written right after the start and before the talker and code, with nothing between (Lynxmotion LSS's "
             "servo id: `address: id` reads `#5D1800` as id 5, code D, 1800). Messages, JSON and client methods have "
-            "it as a field; the simulator answers with the request's. The C target refuses it, saying so.",
+            "it as a field; the simulator answers with the request's.",
             example="id",
         ),
         "max_length": Int(
@@ -1673,8 +1671,7 @@ FRAMING = Obj(
             "integer field as hex digits (`1A F8`: a = 26, b = 248, the engine at (256 a + b) / 4 = 1726 rpm), "
             "zero-padded to `width` digits, "
             "in upper case (`case: lower` for lower case), a negative value after `-`; decode reads either case. "
-            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18); it refuses line "
-            "endings by direction and reply codes of their own, one line each.",
+            "The C target writes and reads hex integers (up to 15 digits, as decimal ones up to 18).",
         ),
     ),
 )

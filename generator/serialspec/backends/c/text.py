@@ -63,6 +63,11 @@ def _items(m: TextMessage) -> list[TextField | TextRepeat]:
     return list(m.fields)
 
 
+def _sent(m: TextMessage) -> list[TextField | TextRepeat]:
+    """The fields written after the code: all but an address (`framing.address`: its digits come before it)."""
+    return [f for f in m.fields if not (isinstance(f, TextField) and f.address)]
+
+
 class TextC:
     """One text protocol's C."""
 
@@ -70,7 +75,8 @@ class TextC:
         refuse(text)
         self.protocol, self.text = protocol, text
         self.p, self.P = protocol.name, protocol.name.upper()
-        self.limit = text.max_length + len(text.end)
+        # the longest frame the parser holds: max_length and the longer line ending (each direction may have its own)
+        self.limit = text.max_length + max(len(text.end), len(text.response_end))
         self.bare_macros = ""  # replies of values alone: the macros that tell their kinds (bare_decode)
         self.calls: set[str] = set()  # the runtime's helpers the code written calls (text_runtime.used)
 
@@ -320,7 +326,7 @@ const char *{p}_result_name(int result);
         if f.letters:
             allowed = " && ".join(f"{target} != '{_c_char(letter)}'" for _, letter in f.letters)
             letters = f"\n        if (r == {P}_OK && {allowed}) {{\n            r = {P}_E_CONTENT;\n        }}"
-        return f"""    {self.call("next")}(c, &s, &len);
+        return f"""    {self.call("rest" if f.rest else "next")}(c, &s, &len);
     {lv}has_{n} = len > 0u;
     if (len > 0u) {{
         r = {call};{letters}
@@ -333,7 +339,7 @@ const char *{p}_result_name(int result);
         p, P = self.p, self.P
         lines: list[str] = []
         at = 0
-        for item in _items(m):
+        for item in _sent(m):
             if isinstance(item, TextField):
                 lines.append(self.read(item, "m->"))
                 at += 1
@@ -369,8 +375,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
     return c->more ? {P}_E_LENGTH : {P}_OK; /* more fields than the message has */
 }}"""
 
-    def check(self, f: TextField, lv: str) -> str:
-        """The range checks of one field (encode refuses with P_E_RANGE before it writes)."""
+    def check(self, f: TextField, lv: str, own: str = "", rest_own: str = "") -> str:
+        """The range checks of one field (encode refuses with P_E_RANGE before it writes); `own`: the characters of
+        the message's own layout, which its texts may not hold either."""
         P, n = self.P, ident(f.name)
         v = f"{lv}{n}"
         tests: list[str] = []
@@ -398,8 +405,14 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 if f.letters:
                     tests.append(" && ".join(f"{v} != '{_c_char(letter)}'" for _, letter in f.letters))
                 tests.append(f"!{self.call('carried')}({v})")
+                if own:
+                    tests.append(f"!{self.call('avoids')}(&{v}, 1u, {_c_string(own)})")
             case "text":
-                tests.append(f"{v}_len > {P}_TEXT_MAX || !{self.call('text_ok')}({v}, {v}_len)")
+                ok = self.call("rest_ok" if f.rest else "text_ok")
+                tests.append(f"{v}_len > {P}_TEXT_MAX || !{ok}({v}, {v}_len)")
+                mine = rest_own if f.rest else own  # a text to the end of the line may hold the separators
+                if mine:
+                    tests.append(f"!{self.call('avoids')}({v}, {v}_len, {_c_string(mine)})")
             case "time":
                 tests.append(f"!{self.call('time_ok')}(&{v})")
             case "date":
@@ -408,7 +421,9 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 assert_never(f.kind)
         return "\n".join(f"    if ({lv}has_{n} && ({t})) {{\n        return {P}_E_RANGE;\n    }}" for t in tests)
 
-    def write(self, f: TextField, lv: str) -> str:
+    def write(self, f: TextField, lv: str, part: str = "") -> str:
+        """The writing of one field after the framing's separator, or (`part`: the separator of a message's own
+        layout, as C) as a part of its layout, after that separator where a part comes before it."""
         n = ident(f.name)
         v = f"{lv}{n}"
         match f.kind:
@@ -430,38 +445,73 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 call = f"{self.call('put_date')}(o, &{v})"
             case _:
                 assert_never(f.kind)
-        return f"    {self.call('put')}(o, {self.P}__SEPARATOR);\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+        before = f"{self.call('part')}(o, &first, {part})" if part else f"{self.call('put')}(o, {self.P}__SEPARATOR)"
+        if f.rest and not part:  # the separators in it are its own (p__trim)
+            before += ";\n    o->rest = o->n"
+        return f"    {before};\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
 
     def encoder(self, m: TextMessage) -> str:
         p, P = self.p, self.P
         checks: list[str] = []
         writes: list[str] = []
-        for item in _items(m):
+        layout = m.layout
+        own, part, joined = "", "", ""
+        if layout is not None:  # its own separator (a repeat's values joined by `list`) and characters
+            own = "".join(
+                sorted({layout.start, layout.end, layout.separator, layout.list, layout.after_code or ""} - {""})
+            )
+            part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
+        rest_own = (
+            "".join(sorted(set(own) - {layout.separator, layout.after_code or "", self.text.separator}))
+            if layout
+            else ""
+        )
+        t = self.text
+        if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
+            own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
+        for item in _sent(m):
             if isinstance(item, TextField):
-                checks.append(self.check(item, "m->"))
-                writes.append(self.write(item, "m->"))
+                checks.append(self.check(item, "m->", own, rest_own))
+                writes.append(self.write(item, "m->", part))
                 continue
             name = ident(item.name)
             groups = f"{item.count}u" if item.count else f"m->{name}_count"
             if not item.count:
                 checks.append(f"    if (m->{name}_count > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
-            inner = "\n".join(self.check(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            inner = "\n".join(self.check(f, f"m->{name}[g].", own) for f in item.fields).replace("\n", "\n    ")
             checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
-            inner = "\n".join(self.write(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            inner = "\n".join(
+                self.write(f, f"m->{name}[g].", (f"g == 0u ? {part} : {joined}" if k == 0 else joined) if part else "")
+                for k, f in enumerate(item.fields)
+            ).replace("\n", "\n    ")
             writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
         head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
+        written = "\n".join(writes)
+        if layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text
+            after = layout.separator if layout.after_code is None else layout.after_code
+            written = (
+                f"    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);\n    fields = o->n;\n{written}\n"
+                f"    if ({'first' if layout.start else 'o->n == fields'}) {{ /* no field's text: the code alone */\n"
+                f"        o->n = code;\n    }}\n"
+                f"    {self.call('put_text')}(o, {_c_string(layout.end)}, {len(layout.end)}u);"
+            )
+            head += ", in its own layout"
         return f"""/* {head}: the range checks (when asked), then each
  * field after a separator, an absent one empty. */
 static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
 {{
-    size_t g = 0u;
+    size_t g = 0u, code = o->n, fields = o->n;
+    int first = 1;
     (void)g;
     (void)m;
     (void)o;
+    (void)code;
+    (void)fields;
+    (void)first;
     if (check) {{
 {chr(10).join(checks).replace(chr(10), chr(10) + "    ") if checks else ""}
     }}
-{chr(10).join(writes)}
+{written}
     return {P}_OK;
 }}"""
 
@@ -533,14 +583,240 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
         c.pos = 0u;
     }}
 """
-        write = f"""    if ({P}__BARE(msg->kind) && !o.full && o.n > {P}__S && o.b[{P}__S] == {P}__SEPARATOR) {{
-        for (i = {P}__S; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
+        write = f"""    for (at = {P}__S; at < o.n && o.b[at] >= 0x30u && o.b[at] <= 0x39u; at++) {{
+    }} /* past an address */
+    if ({P}__BARE(msg->kind) && !o.full && o.n > at && o.b[at] == {P}__SEPARATOR) {{
+        for (i = at; i + 1u < o.n; i++) {{ /* a reply of values alone: no separator before its first value */
             o.b[i] = o.b[i + 1u];
         }}
         o.n--;
     }}
 """
         return helpers, read, write, f"{p}__bare_reply(expect)"
+
+    def address(self) -> tuple[str, str, str]:
+        """An address before the code (`framing.address`: Lynxmotion LSS's servo id, `#5QD`): every message's first
+        field, its decimal digits right after the start (runtime/text.py TextFraming._decode_body): the decoder's
+        reading of them, __body's writing of them (range-checked first) and the decoder's setting of every message's
+        member after its fields."""
+        P, f = self.P, self.text.address
+        if f is None:
+            return "", "", ""
+        n = ident(f.name)
+        sets = "\n".join(
+            f"        case {P}_{mid(m).upper()}:\n            out->u.{mid(m)}.{n} = number;\n"
+            f"            out->u.{mid(m)}.has_{n} = digits > 0u;\n            break;"
+            for m in self.text.messages
+        )
+        read = f"""    while (digits < n && frame[body + digits] >= 0x30u && frame[body + digits] <= 0x39u) {{
+        digits++; /* the address: the digits right after the start */
+    }}
+    if (digits > 18u) {{
+        return {P}_E_CAPACITY;
+    }}
+    for (i = 0u; i < digits; i++) {{
+        number = number * 10 + (int64_t)(frame[body + i] - 0x30u);
+    }}
+    body += digits;
+    n -= digits;
+"""
+        set_ = f"""    if (r == {P}_OK) {{
+        switch (kind) {{ /* the address, every message's first field */
+{sets}
+        default:
+            break;
+        }}
+    }}
+"""
+        writes = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n"
+            + "\n".join("    " + line for line in self.check(f, f"msg->u.{mid(m)}.").split("\n")).replace(
+                f"    if (msg->u.{mid(m)}.has_{n} &&", f"    if (check && msg->u.{mid(m)}.has_{n} &&"
+            )
+            + f"\n        if (msg->u.{mid(m)}.has_{n}) {{\n"
+            f"            {self.call('put_integer')}(o, msg->u.{mid(m)}.{n}, {f.width}u);\n        }}\n        break;"
+            for m in self.text.messages
+        )
+        write = f"""    switch (msg->kind) {{ /* the address first, its digits before the talker and code */
+{writes}
+    default:
+        break;
+    }}
+"""
+        return read, write, set_
+
+    def framed(self) -> tuple[str, str]:
+        """Messages in their own text with a start (GRBL's `[MSG:...]`, runtime/text.py TextFraming._decode_in): the
+        decoder's reading of a frame whose text starts with a layout's start and ends with its end (the talker and
+        code up to its separator, then its fields), and __body's writing of the start before the talker."""
+        p, P, t = self.p, self.P, self.text
+        layouts = list(dict.fromkeys(m.layout for m in t.messages if m.layout is not None and m.layout.start))
+        if not layouts:
+            return "", ""
+        reads = []
+        for index, layout in enumerate(layouts):
+            kinds = " || ".join(f"kind == {P}_{mid(m).upper()}" for m in t.messages if m.layout == layout)
+            s, e = len(layout.start), len(layout.end)
+            starts = f'{self.call("alone")}(frame + body, n, {_c_string(layout.start)}, {s}u, "", 0u, '
+            ends = f"{_c_string(layout.end)}, {e}u, &at, &inner)"
+            reads.append(f"""    if (!own && {starts}{ends} &&
+        n >= {s + e}u) {{ /* its own text: {comment(repr(layout.start))} ... (layout {index}) */
+        const uint8_t *t = frame + body + {s}u;
+        size_t cut = 0u, k = 0u;
+        inner = n - {s + e}u;
+        own = 1;
+        while (cut < inner && t[cut] != {_byte(layout.separator)}) {{
+            cut++;
+        }}
+        talker = cut < {t.talker}u ? cut : {t.talker}u;
+        for (k = 0u; k < talker; k++) {{
+            out->talker[k] = (char)t[k];
+        }}
+        out->talker[talker] = '\\0';
+        kind = {p}__lookup(t + talker, cut - talker, dir);
+        if (kind == {P}_KIND_NONE || !({kinds})) {{
+            return {P}_E_UNKNOWN; /* no message of this text */
+        }}
+        c.b = t + (cut < inner ? cut + 1u : inner);
+        c.n = cut < inner ? inner - cut - 1u : 0u;
+        c.pos = 0u;
+        c.more = cut < inner;
+        c.sep = {_byte(layout.separator)};
+        c.list = {_byte(layout.list or layout.separator)};
+        seps = cut < inner ? 1u : 0u;
+        for (k = 0u; k < c.n; k++) {{
+            if (c.b[k] == c.sep || c.b[k] == c.list) {{
+                seps++;
+            }}
+        }}
+        out->sent = -1;
+    }}
+""")
+        inner = "\n".join("    " + line if line else line for line in "".join(reads).split("\n"))
+        read = "    {\n        size_t at = 0u, inner = 0u;\n" + inner + "    }\n"
+        writes = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n"
+            f"        {self.call('put_text')}(o, {_c_string(m.layout.start)}, {len(m.layout.start)}u);\n        break;"
+            for m in t.messages
+            if m.layout is not None and m.layout.start
+        )
+        write = (
+            f"    switch (msg->kind) {{ /* a message's own start, before the talker */\n{writes}\n"
+            "    default:\n        break;\n    }\n"
+        )
+        return "    int own = 0; /* a frame in a message's own text with a start */\n" + read, write
+
+    def alone_decode(self) -> tuple[str, str, str]:
+        """Messages in their own layout, found by their code alone (an ELM327's reply `41 0C 1A F8 `, an AT modem's
+        `+CSQ: 20,99`; runtime/text.py TextFraming._decode_alone), tried where the frame's first field is no code of
+        a message of `dir` in the framing's own text: the helper before the decoder, the decoder's reading of one,
+        and the test of the kinds whose frames are written in their own layout (encode ignores `sent` there)."""
+        p, P, t = self.p, self.P, self.text
+        own_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in t.messages if m.layout) or "0"
+        found = [m for m in t.messages if m.layout is not None and not m.layout.start]  # by their code alone
+        alone = sorted(found, key=lambda m: -len(m.code))
+        if not alone:
+            return "", "", own_kinds
+        plain = [m for m in t.messages if m.layout is None and not m.values_only]
+        cases = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n        return dir == {P}_{m.direction.name};" for m in plain
+        )
+        body = f"    switch (kind) {{\n{cases}\n    default:\n        return 0;\n    }}" if plain else "    return 0;"
+        helpers = f"""/* 1 when `kind` (a frame's first field's) is a message of `dir` in the framing's text. */
+static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
+{{
+    (void)kind;
+    (void)dir;
+{body}
+}}
+
+"""
+        skip = f"({t.talker}u < n ? {t.talker}u : n)" if t.talker else "0u"
+        tries: list[str] = []
+        for m in alone:
+            layout = m.layout
+            assert layout is not None
+            after = layout.separator if layout.after_code is None else layout.after_code
+            call = (
+                f"{self.call('alone')}(t, tn, {_c_string(m.code)}, {len(m.code)}u, {_c_string(after)}, {len(after)}u, "
+                f"{_c_string(layout.end)}, {len(layout.end)}u, &at, &inner)"
+            )
+            tries.append(
+                f"        {'if' if not tries else '} else if'} (dir == {P}_{m.direction.name} &&\n"
+                f"            {call}) {{\n"
+                f"            kind = {P}_{mid(m).upper()};\n"
+                f"            c.sep = {_byte(layout.separator)};\n"
+                f"            c.list = {_byte(layout.list or layout.separator)};"
+            )
+        read = f"""    if (!{p}__plain(kind, dir)) {{ /* found by its code alone, of `dir`: longest code first */
+        const uint8_t *t = frame + body + {skip};
+        size_t tn = n - {skip}, at = 0u, inner = 0u;
+        int found = 1;
+{chr(10).join(tries)}
+        }} else {{
+            found = 0;
+        }}
+        if (found) {{ /* its fields, between its own separators */
+            c.b = t + at;
+            c.n = inner;
+            c.pos = 0u;
+            c.more = inner > 0u;
+            seps = inner > 0u ? 1u : 0u;
+            for (i = 0u; i < inner; i++) {{
+                if (c.b[i] == c.sep || c.b[i] == c.list) {{
+                    seps++;
+                }}
+            }}
+            out->sent = -1;
+        }}
+    }}
+"""
+        return helpers, read, own_kinds
+
+    def ends(self) -> str:
+        """The line endings as C: the requests' (`end`), the responses' where they have their own (ELM327's CR CR
+        `>`), and the macros that give a direction's."""
+        p, P, t = self.p, self.P, self.text
+
+        def array(name: str, ending: str, what: str) -> str:
+            bytes_ = ", ".join(_byte(c) for c in ending)
+            return f"static const uint8_t {p}__{name}[] = {{{bytes_}, 0x00u}}; /* {comment(repr(ending))}, {what} */\n"
+
+        if not t.response_end:
+            return (
+                array("end", t.end, "the line ending")
+                + f"#define {P}__END(dir) {p}__end\n#define {P}__END_LEN(dir) (sizeof({p}__end) - 1u)\n"
+            )
+        return (
+            array("end", t.end, "the requests' line ending")
+            + array("response_end", t.response_end, "the responses' line ending")
+            + f"#define {P}__END(dir) ((dir) == {P}_RESPONSE ? {p}__response_end : {p}__end)\n"
+            + f"#define {P}__END_LEN(dir) \\\n"
+            + f"    ((dir) == {P}_RESPONSE ? sizeof({p}__response_end) - 1u : sizeof({p}__end) - 1u)\n"
+        )
+
+    def marked(self) -> bool:
+        """Whether every frame carries the checksum's marker (else texts of the directions without may hold it)."""
+        t = self.text
+        return t.checksum is not None and len(t.checksum_directions) == 2
+
+    def direction(self) -> str:
+        """The direction of a message of each kind (encode writes its line ending)."""
+        p, P = self.p, self.P
+        cases = "\n".join(
+            f"    case {P}_{mid(m).upper()}:" for m in self.text.messages if m.direction.value == "response"
+        )
+        body = (
+            f"    switch (kind) {{\n{cases}\n        return {P}_RESPONSE;\n"
+            f"    default:\n        return {P}_REQUEST;\n    }}"
+            if cases
+            else f"    (void)kind;\n    return {P}_REQUEST;"
+        )
+        return f"""/* The direction of a message of `kind`. */
+static {p}_direction_t {p}__direction({p}_kind_t kind)
+{{
+{body}
+}}"""
 
     def bare_expect(self) -> str:
         """p_parser_expect where replies of values alone are read as the reply awaited (TextStreamParser.expect)."""
@@ -555,8 +831,22 @@ void {p}_parser_expect({p}_parser_t *parser, {p}_kind_t reply)
     def source(self) -> str:
         p, P, t = self.p, self.P, self.text
         bare = [m for m in t.messages if m.values_only]  # replies of values alone (`values_only`)
-        end = ", ".join(_byte(c) for c in t.end)
-        special_characters = sorted({t.start, t.separator, t.marker, *t.end} - {""})
+        ends = self.ends()
+        # the checksum's marker where every frame carries it (else: a check of the messages of the directions that do)
+        marker = t.marker if self.marked() else ""
+        special_characters = sorted({t.start, t.response_start, t.separator, marker, *t.end, *t.response_end} - {""})
+        one_way = t.checksum is not None and len(t.checksum_directions) == 1
+        checks = (
+            "0" if t.checksum is None else "1" if not one_way else f"((dir) == {P}_{t.checksum_directions[0].upper()})"
+        )
+        again = (
+            f"    if (r == {P}_OK && !again && {P}__CHECKS(dir) && !{P}__CHECKS({p}__direction(kind))) {{\n"
+            f"        return {P}__AGAIN; /* a code of the other direction alone (runtime/text.py _decode_checked) */\n"
+            f"    }}\n"
+            if one_way
+            else ""
+        )
+        direction = f"#if {P}_ENABLE_ENCODE || ({P}_ENABLE_DECODE && {int(one_way)})\n{self.direction()}\n#endif\n\n"
         checked = t.checksum is not None
         checksum, reflects = "", False
         if t.checksum is not None:
@@ -587,6 +877,10 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
 }}
 """
         decoders = "\n\n".join(self.decoder(m) for m in t.messages)
+        alone_helpers, alone_read, own_kinds = self.alone_decode()
+        address_read, address_write, address_set = self.address()
+        start_read, start_write = self.framed()
+        address_decl = "    size_t digits = 0u;\n    int64_t number = 0;\n" if address_read else ""
         encoders = "\n\n".join(self.encoder(m) for m in t.messages)
         by_code: dict[str, list[TextMessage]] = {}
         for m in t.messages:
@@ -602,7 +896,14 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
             lookups.append(f"    if ({p}__is(code, n, {c_text(name)})) {{\n        return {pick};\n    }}")
         dec_cases = "\n".join(
             f"    case {P}_{mid(m).upper()}:\n        memset(&out->u.{mid(m)}, 0, sizeof(out->u.{mid(m)}));\n"
-            f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n        break;"
+            f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n"
+            + (
+                f"        if (out->sent > {len(_sent(m))}) {{ /* a text to the end of the line is one field */\n"
+                f"            out->sent = {len(_sent(m))};\n        }}\n"
+                if _ends_with_rest(m)
+                else ""
+            )
+            + "        break;"
             for m in t.messages
         )
         enc_cases = "\n".join(
@@ -679,6 +980,9 @@ static int {p}__special(uint8_t c)
         separated_dirs = f"({separated_dirs})" if separated_dirs else "0"
         separated_kinds = " || ".join(f"msg->kind == {P}_{mid(m).upper()}" for m in separated) or "0"
         bare_helpers, bare_read, bare_write, expect_reply = self.bare_decode(bare)
+        if start_read:  # a frame in a layout with a start is read as it, nothing else
+            alone_read = alone_read.replace(f"    if (!{p}__plain(", f"    if (!own && !{p}__plain(", 1)
+            bare_read = bare_read.replace("    if (reply != ", "    if (!own && reply != ", 1)
         talker_write_bare = talker_write
         if bare and talker_write:  # a reply of values alone: no talker written
             talker_write_bare = f"    if (!{P}__BARE(msg->kind)) {{\n{talker_write}\n    }}"
@@ -692,7 +996,20 @@ static int {p}__special(uint8_t c)
             else f"#define {P}__REPLY(p) {P}_KIND_NONE\n#define {P}__ANSWERED(p, out) ((void)0)\n"
             f"#define {P}__INIT_REPLY(p) ((void)0)\n"
         )
-        start = f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n" if t.start else ""
+        start = ""
+        if t.start and not t.response_start:
+            start = (
+                f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))} */\n"
+                f"#define {P}__START_OF(dir) {P}__START\n#define {P}__IS_START(c) ((c) == {P}__START)\n"
+            )
+        elif t.start:  # each direction its own (Lynxmotion LSS: `#` asks, `*` answers)
+            start = (
+                f"#define {P}__START {_byte(t.start)} /* {comment(repr(t.start))}: the requests' */\n"
+                f"#define {P}__RESPONSE_START {_byte(t.response_start)} /* {comment(repr(t.response_start))}: the "
+                "responses' */\n"
+                f"#define {P}__START_OF(dir) ((dir) == {P}_RESPONSE ? {P}__RESPONSE_START : {P}__START)\n"
+                f"#define {P}__IS_START(c) ((c) == {P}__START || (c) == {P}__RESPONSE_START)\n"
+            )
         room = f"    if (cap < 1u) {{\n        return {P}_E_BUFFER;\n    }}\n" if t.start else ""
         text = f"""{banner(self.protocol)}
 #include "{p}.h"
@@ -710,13 +1027,16 @@ static int {p}__special(uint8_t c)
 {start}#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
 #define {P}__MARKER {_byte(t.marker)}          /* {comment(repr(t.marker))}: the checksum follows */
 #define {P}__CHECKED {int(checked)}            /* a checksum is written */
+#define {P}__CHECKS(dir) {checks} /* the frames of `dir` carry it */
+#define {P}__AGAIN (-1) /* p__decode_in: read it again as the other direction's (no checksum) */
 #define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
 #define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
 #define {P}__SEPARATED(dir) {separated_dirs} /* a separator before the marker */
-#define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
+/* the parser drops a line longer than this without its line ending */
+#define {P}__LIMIT(dir) ({t.max_length}u + {P}__END_LEN(dir))
 {reply_macros}#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
-static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
-#endif
+{ends}#endif
+#define {P}__OTHER(dir) ((dir) == {P}_REQUEST ? {P}_RESPONSE : {P}_REQUEST)
 
 #if {P}_ENABLE_DECODE || {P}_ENABLE_PARSER
 /* 1 when a[0..n) and b[0..n) hold the same bytes */
@@ -747,7 +1067,7 @@ static int {p}__is(const uint8_t *b, size_t n, const char *s)
 #endif
 
 {written([special], helpers)}{reflect}{checksum}{runtime}
-#if {P}_ENABLE_DECODE
+{direction}#if {P}_ENABLE_DECODE
 {decoders}
 
 /* The message a text code names: the one it names, or the one of `dir` where it names a request and a response. */
@@ -758,11 +1078,14 @@ static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir
     return {P}_KIND_NONE;
 }}
 
-{bare_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's first field is
- * no code of `dir` (runtime/text.py TextFraming.decode's `reply`). */
-static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
-                       {p}_msg_t *out)
+{bare_helpers}{alone_helpers}/* `reply`: a reply of values alone awaited ({P}_KIND_NONE: none), read where the frame's
+ * first field is no code of `dir` (runtime/text.py TextFraming.decode's `reply`). `again`: a frame of the other
+ * direction's (its line ending taken off), read as `dir`, which carries no checksum. */
+static int {p}__decode_in(const uint8_t *frame, size_t len, {p}_direction_t dir, int again, {p}_kind_t expect,
+                          {p}_kind_t reply, {p}_msg_t *out)
 {{
+    const {p}_direction_t sent_as = again ? {P}__OTHER(dir) : dir;
+{address_decl}
     size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
     {p}__cursor_t c;
     {p}_kind_t kind;
@@ -771,17 +1094,17 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
         return {P}_E_ARG;
     }}
     out->kind = {P}_KIND_NONE;
-    if (!{P}__DECODES(dir)) {{ /* the other side's direction, left out of this build */
+    if (!{P}__DECODES(sent_as)) {{ /* the other side's direction, left out of this build */
         return {P}_E_ARG;
     }}
     if (len > {P}_MAX_FRAME) {{
         return {P}_E_CAPACITY;
     }}
-    r = {p}__unframe(frame, len, dir, &body, &n, &unchecked);
+    r = {p}__unframe(frame, len, sent_as, !again && {P}__CHECKS(dir), &body, &n, &unchecked);
     if (r != {P}_OK) {{
         return r;
     }}
-    address = n;
+{address_read}    address = n;
     for (i = n; i > 0u; i--) {{
         if (frame[body + i - 1u] == {P}__SEPARATOR) {{
             seps++;
@@ -795,7 +1118,9 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     c.n = n;
     c.more = address < n;
     c.pos = address < n ? address + 1u : n;
-{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+    c.sep = {P}__SEPARATOR;
+    c.list = {P}__SEPARATOR;
+{start_read}{alone_read}{bare_read}    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
         return {P}_E_UNKNOWN;
     }}
     out->unchecked = unchecked != 0;
@@ -806,8 +1131,18 @@ static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p
     default:
         return {P}_E_UNKNOWN;
     }}
-    if (r == {P}_OK) {{
+{again}{address_set}    if (r == {P}_OK) {{
         out->kind = kind;
+    }}
+    return r;
+}}
+
+static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_kind_t reply,
+                       {p}_msg_t *out)
+{{
+    int r = {p}__decode_in(frame, len, dir, 0, expect, reply, out);
+    if (r == {P}__AGAIN) {{ /* a code of the other direction alone: its frame is text to its end, the marker too */
+        r = {p}__decode_in(frame, len, {P}__OTHER(dir), 1, expect, reply, out);
     }}
     return r;
 }}
@@ -825,10 +1160,10 @@ int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t 
 
 {encoders}
 
-/* Talker, code and fields (range-checked when `check`), from o's position on. */
+/* Address, talker, code and fields (range-checked when `check`), from o's position on. */
 static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
 {{
-{talker_write_bare}
+{address_write}{start_write}{talker_write_bare}
     switch (msg->kind) {{
 {enc_cases}
     case {P}_KIND_NONE:
@@ -849,6 +1184,7 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     o.cap = cap;
     o.n = 0u;
     o.full = 0;
+    o.rest = 0u;
     r = {p}__body(msg, &o, 0);
     if (r == {P}_OK && o.full) {{
         r = {P}_E_BUFFER;
@@ -859,11 +1195,13 @@ int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 
 {parser}
 #if {P}_ENABLE_ENCODE
+
 int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
 {{
     {p}__out_t o;
-    size_t i;
+    size_t i, at = 0u;
     int r;
+    (void)at;
     if (msg == NULL || buf == NULL || len == NULL) {{
         return {P}_E_ARG;
     }}
@@ -872,18 +1210,19 @@ int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
     o.cap = cap;
     o.n = {P}__S;
     o.full = 0;
+    o.rest = 0u;
     r = {p}__body(msg, &o, 1);
     if (r != {P}_OK) {{
         return r;
     }}
-    if (msg->sent >= 0 && !o.full) {{ /* as many fields as the sentence had */
+    if (msg->sent >= 0 && !o.full && !({own_kinds})) {{ /* as many fields as the sentence had */
         r = {p}__trim(&o, (size_t)msg->sent);
         if (r != {P}_OK) {{
             return r;
         }}
     }}
 {bare_write}
-    return {p}__frame(&o, len, msg->unchecked, {separated_kinds});
+    return {p}__frame(&o, len, msg->unchecked, {separated_kinds}, {p}__direction(msg->kind));
 }}
 #endif
 
@@ -908,6 +1247,17 @@ const char *{p}_result_name(int result)
 }}
 """
         return text
+
+
+def _ends_with_rest(m: TextMessage) -> bool:
+    """Whether the message's last field is a text to the end of the line (`size: rest`)."""
+    return bool(m.fields) and isinstance(m.fields[-1], TextField) and m.fields[-1].rest
+
+
+def _c_string(text: str) -> str:
+    """Any text as a C string literal: letters and digits as they are, every other character as an octal escape (no
+    trigraph, no escape that runs on)."""
+    return '"' + "".join(c if c.isascii() and c.isalnum() else f"\\{ord(c):03o}" for c in text) + '"'
 
 
 def _c_char(c: str) -> str:
@@ -975,8 +1325,12 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
         for item in m.fields:
             comma = "" if first else ","
             first = False
+            if isinstance(item, TextField) and item.address:  # its digits, first in the text
+                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_text(&j, body, lead);')
+                continue
             if isinstance(item, TextField):
-                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_field(&j, &c);')
+                read = "j_rest" if item.rest else "j_field"
+                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__{read}(&j, &c);')
                 continue
             groups = f"{item.count}u" if item.count else f"msg->u.{mid(m)}.{ident(item.name)}_count"
             names = []
@@ -991,6 +1345,21 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
                 f'    {p}__j_str(&j, "]");'
             )
         body = "\n".join(parts)
+        if m.layout is not None:  # its own layout: the fields after the talker, code and what follows the code
+            layout = m.layout
+            after = layout.separator if layout.after_code is None else layout.after_code
+            body = (
+                (
+                    f"    for (c.pos = 0u; c.pos < {text.talker}u && msg->talker[c.pos] != '\\0'; c.pos++) {{\n    }}\n"
+                    if text.talker
+                    else "    c.pos = 0u;\n"
+                )
+                + f"    c.pos += {'lead + ' if text.address else ''}{len(layout.start) + len(m.code) + len(after)}u;\n"
+                + (f"    c.n = len >= {len(layout.end)}u ? len - {len(layout.end)}u : 0u;\n" if layout.end else "")
+                + f"    c.pos = c.pos < c.n ? c.pos : c.n;\n"
+                f"    c.sep = {_byte(layout.separator)};\n    c.list = {_byte(layout.list or layout.separator)};\n"
+                + body
+            )
         cases.append(
             f"    case {P}_{mid(m).upper()}:\n"
             f'        {p}__j_str(&j, "{{\\"command\\":\\"{m.key}\\",\\"subcommand\\":null,\\"direction\\":'
@@ -999,6 +1368,20 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
             + "\n".join("    " + line if line else line for line in body.split("\n"))
             + f'\n        {p}__j_str(&j, "}}}}");\n        break;'
         )
+    rest = ""
+    if any(_ends_with_rest(m) for m in text.messages):
+        rest = f"""/* A text to the end of the line: the rest of the fields' text. */
+static void {p}__j_rest({p}__json_t *j, {p}__jcur_t *c)
+{{
+    {p}__j_text(j, c->b + c->pos, c->n - c->pos);
+    c->pos = c->n;
+}}
+
+"""
+    lead = ""
+    if text.address is not None:  # the address's digits, before the talker and code
+        lead = "    while (lead < len && body[lead] >= 0x30u && body[lead] <= 0x39u) {\n        lead++;\n    }\n"
+        lead += "    c.pos = lead;\n"
     talker_length = "    i = 0u;"
     if text.talker:
         talker_length = f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}"
@@ -1052,17 +1435,20 @@ static void {p}__j_text({p}__json_t *j, const uint8_t *t, size_t n)
     {p}__j_char(j, '"');
 }}
 
-/* The fields' texts one after another, as the frame has them after the address. */
+/* The fields' texts one after another, as the frame has them after the address, ended by sep or list (a message's
+ * own layout's). */
 typedef struct {{
     const uint8_t *b;
     size_t n;
     size_t pos;
+    uint8_t sep;
+    uint8_t list;
 }} {p}__jcur_t;
 
 static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
 {{
     size_t start = c->pos;
-    while (c->pos < c->n && c->b[c->pos] != {_byte(text.separator)}) {{
+    while (c->pos < c->n && c->b[c->pos] != c->sep && c->b[c->pos] != c->list) {{
         c->pos++;
     }}
     {p}__j_text(j, c->b + start, c->pos - start);
@@ -1071,7 +1457,7 @@ static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
     }}
 }}
 
-static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
+{rest}static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
 {{
     char number[40];
     size_t i;
@@ -1087,7 +1473,8 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     {p}__json_t j;
     {p}__jcur_t c;
     uint8_t body[{P}__JSON_BODY];
-    size_t len = 0u, g = 0u;
+    size_t len = 0u, g = 0u, lead = 0u;
+    (void)lead;
     j.out = out;
     j.cap = cap;
     j.n = 0u;
@@ -1098,7 +1485,9 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     c.b = body;
     c.n = len;
     c.pos = 0u;
-    while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the address: skipped */
+    c.sep = {_byte(text.separator)};
+    c.list = {_byte(text.separator)};
+{lead}    while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the talker and code: skipped */
         c.pos++;
     }}
     if (c.pos < c.n) {{

@@ -82,12 +82,15 @@ HEAD = (
     Piece(
         r"""#endif
 
-/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
+/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last; sep and
+ * list end a field (the framing's separator, or a message's own separator and list character). */
 typedef struct {
     const uint8_t *b;
     size_t n;
     size_t pos;
     int more;
+    uint8_t sep;
+    uint8_t list;
 } pfx__cursor_t;
 
 #if PFX_ENABLE_DECODE
@@ -105,7 +108,7 @@ static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
         *len = 0u;
         return;
     }
-    while (i < c->n && c->b[i] != PFX__SEPARATOR) {
+    while (i < c->n && c->b[i] != c->sep && c->b[i] != c->list) {
         i++;
     }
     *start = c->pos;
@@ -116,6 +119,63 @@ static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
 
 """,
         "next",
+        (),
+    ),
+    Piece(
+        r"""/* A message found by its code alone (runtime/text.py TextFraming._decode_alone): 1 when t[0..n) starts with
+ * code[0..k) and the rest is empty or starts with after[0..a) and ends with end[0..e); its fields are then
+ * t[*at, *at + *len). */
+static int pfx__alone(const uint8_t *t, size_t n, const char *code, size_t k, const char *after, size_t a,
+                      const char *end, size_t e, size_t *at, size_t *len)
+{
+    size_t i;
+    if (n < k) {
+        return 0;
+    }
+    for (i = 0u; i < k; i++) {
+        if (t[i] != (uint8_t)code[i]) {
+            return 0;
+        }
+    }
+    if (n == k) {
+        *at = k;
+        *len = 0u;
+        return 1;
+    }
+    if (n - k < a || n - k < e) {
+        return 0;
+    }
+    for (i = 0u; i < a; i++) {
+        if (t[k + i] != (uint8_t)after[i]) {
+            return 0;
+        }
+    }
+    for (i = 0u; i < e; i++) {
+        if (t[n - e + i] != (uint8_t)end[i]) {
+            return 0;
+        }
+    }
+    *at = k + a;
+    *len = n - k >= a + e ? n - k - a - e : 0u;
+    return 1;
+}
+
+""",
+        "alone",
+        (),
+    ),
+    Piece(
+        r"""/* A text to the end of the line (`size: rest`): the rest of the sentence, separators included. */
+static void pfx__rest(pfx__cursor_t *c, size_t *start, size_t *len)
+{
+    *start = c->more ? c->pos : c->n;
+    *len = c->n - *start;
+    c->more = 0;
+    c->pos = c->n;
+}
+
+""",
+        "rest",
         (),
     ),
     Piece(
@@ -407,7 +467,8 @@ typedef struct {
     uint8_t *b;
     size_t cap;
     size_t n;
-    int full; /* something did not fit */
+    int full;    /* something did not fit */
+    size_t rest; /* where a text to the end of the line begins (0: none; the separators in it are its own) */
 } pfx__out_t;
 
 """,
@@ -427,6 +488,20 @@ typedef struct {
 """,
         "put",
         (),
+    ),
+    Piece(
+        r"""/* Between the parts of a message in its own layout: `c` before every part but the first. */
+static void pfx__part(pfx__out_t *o, int *first, uint8_t c)
+{
+    if (!*first) {
+        pfx__put(o, c);
+    }
+    *first = 0;
+}
+
+""",
+        "part",
+        ("put",),
     ),
     Piece(
         r"""/* v's decimal digits, at least `width` (zeros in front). */
@@ -663,6 +738,42 @@ static int pfx__carried(char c)
         ("carried",),
     ),
     Piece(
+        r"""/* A text to the end of the line: printable ASCII, none of the framing's characters but its separator. */
+static int pfx__rest_ok(const char *t, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (t[i] < 0x20 || t[i] > 0x7E || (pfx__special((uint8_t)t[i]) && (uint8_t)t[i] != PFX__SEPARATOR)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+""",
+        "rest_ok",
+        ("special",),
+    ),
+    Piece(
+        r"""/* 1 when none of t[0..n) is one of a message's own characters `own` (its layout's). */
+static int pfx__avoids(const char *t, size_t n, const char *own)
+{
+    size_t i, k;
+    for (i = 0u; i < n; i++) {
+        for (k = 0u; own[k] != '\0'; k++) {
+            if (t[i] == own[k]) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+""",
+        "avoids",
+        (),
+    ),
+    Piece(
         r"""/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
 static double pfx__angle_value(const pfx_angle_t *a)
 {
@@ -702,24 +813,30 @@ static double pfx__angle_value(const pfx_angle_t *a)
         (),
     ),
     Piece(
-        r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
- * PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: where its frames write the
- * separator before the marker, it is no part of the fields. */
-static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_t *body, size_t *n, int *unchecked)
+        r"""/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked where `check`;
+ * PFX_E_FRAME, PFX_E_CHECKSUM. *unchecked: 1 for a frame without its (optional) checksum. `dir`: the line ending
+ * taken off; where its frames write the separator before the marker, it is no part of the fields. */
+static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, int check, size_t *body, size_t *n,
+                        int *unchecked)
 {
-    size_t i, end = len, stop;
+    size_t i, end = len, stop, ascii, own = PFX__END_LEN(dir), other = PFX__END_LEN(PFX__OTHER(dir));
     *unchecked = 0;
     (void)dir;
-    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
-        end = len - (sizeof(pfx__end) - 1u);
+    (void)check;
+    if (len >= own && pfx__same(f + len - own, PFX__END(dir), own)) {
+        end = len - own; /* the direction's line ending */
     }
-    for (i = 0u; i < end; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
+    ascii = end; /* before the longest line ending of either direction the frame ends with */
+    if (len >= other && other > len - end && pfx__same(f + len - other, PFX__END(PFX__OTHER(dir)), other)) {
+        ascii = len - other;
+    }
+    for (i = 0u; i < ascii; i++) { /* (the line ending may hold bytes above 0x7F: Nextion's FF FF FF) */
         if (f[i] > 0x7Fu) {
             return PFX_E_FRAME; /* a non-ASCII byte */
         }
     }
 #if PFX__S
-    if (end < 1u || f[0] != PFX__START) {
+    if (end < 1u || f[0] != PFX__START_OF(dir)) { /* the direction's start */
         return PFX_E_FRAME;
     }
 #endif
@@ -733,7 +850,7 @@ static int pfx__unframe(const uint8_t *f, size_t len, pfx_direction_t dir, size_
 # the checksum read and written where the protocol has one (text.py leaves them out otherwise)
 _CHECKED_READ = Piece(
     r"""#if PFX__CHECKED
-    {
+    if (check) {
         size_t at = end, k;
         uint32_t written = 0u;
         while (at > PFX__S && f[at - 1u] != PFX__MARKER) {
@@ -791,18 +908,19 @@ MIDDLE = Piece(
 
 #if PFX_ENABLE_ENCODE
 /* Exactly `sent` fields after the address (o->b[PFX__S..n): the address, then each field after a separator): the fields
- * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. */
+ * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. A text to the end of the line
+ * (from o->rest on) is one field, the separators in it its own. */
 static int pfx__trim(pfx__out_t *o, size_t sent)
 {
-    size_t i, k, fields = 0u;
-    for (i = PFX__S; i < o->n; i++) {
+    size_t i, k, fields = 0u, rest = o->rest > 0u ? o->rest : o->n;
+    for (i = PFX__S; i < rest; i++) {
         if (o->b[i] == PFX__SEPARATOR && ++fields > sent) {
             break;
         }
     }
     if (fields > sent) {
         for (k = i; k < o->n; k++) {
-            if (o->b[k] != PFX__SEPARATOR) {
+            if (o->b[k] != PFX__SEPARATOR || k >= rest) {
                 return PFX_E_LENGTH; /* a field after the last one sent has a value */
             }
         }
@@ -817,12 +935,13 @@ static int pfx__trim(pfx__out_t *o, size_t sent)
 
 /* The frame around fields already written from buf[PFX__S]: the start before them, checksum (unless `unchecked`: a
  * frame decoded without its optional one) and end after them. */
-static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated)
+static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated, pfx_direction_t dir)
 {
     size_t k;
     (void)separated;
+    (void)dir;
 #if PFX__S
-    o->b[0] = PFX__START;
+    o->b[0] = PFX__START_OF(dir);
 #endif
     (void)unchecked;
 """,
@@ -831,7 +950,7 @@ static int pfx__frame(pfx__out_t *o, size_t *len, bool unchecked, int separated)
 
 _CHECKED_WRITE = Piece(
     r"""#if PFX__CHECKED
-    if (!unchecked || PFX__REQUIRED) {
+    if ((!unchecked || PFX__REQUIRED) && PFX__CHECKS(dir)) {
         uint32_t sum;
         if (separated) { /* the separator before the marker, covered by the checksum */
             pfx__put(o, PFX__SEPARATOR);
@@ -866,8 +985,8 @@ DECIMAL_CHECKED_WRITE = Piece(
 )
 
 BEFORE_PARSER = Piece(
-    r"""    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
-        pfx__put(o, pfx__end[k]);
+    r"""    for (k = 0u; k < PFX__END_LEN(dir); k++) {
+        pfx__put(o, PFX__END(dir)[k]);
     }
     if (o->full) {
         return PFX_E_BUFFER;
@@ -884,21 +1003,22 @@ BEFORE_PARSER = Piece(
 # the line parser (text.py writes one of the two pushes, then PARSER, after the messages' code)
 START_PUSH = Piece(
     r"""#if PFX_ENABLE_PARSER
-/* Where `c` is in b[from..n), n if nowhere. */
-static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
+/* Where a start (of either direction) is in b[from..n), n if nowhere. */
+static size_t pfx__find(const uint8_t *b, size_t from, size_t n)
 {
-    while (from < n && b[from] != c) {
+    while (from < n && !PFX__IS_START(b[from])) {
         from++;
     }
     return from;
 }
 
-/* Where the line ending is in b[from..n), n if nowhere. */
-static size_t pfx__find_end(const uint8_t *b, size_t from, size_t n)
+/* Where the line ending of `dir` is in b[from..n), n if nowhere. */
+static size_t pfx__find_end(const uint8_t *b, size_t from, size_t n, pfx_direction_t dir)
 {
-    size_t k = sizeof(pfx__end) - 1u;
+    size_t k = PFX__END_LEN(dir);
+    (void)dir;
     for (; from + k <= n; from++) {
-        if (pfx__same(b + from, pfx__end, k)) {
+        if (pfx__same(b + from, PFX__END(dir), k)) {
             return from;
         }
     }
@@ -918,19 +1038,19 @@ static void pfx__drop(pfx_parser_t *p, size_t k)
  * than the spec's max_length, is dropped (counted in errors), as is one that does not decode. */
 static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 {
-    const size_t limit = PFX__LIMIT, k = sizeof(pfx__end) - 1u;
-    if (p->n < PFX__LIMIT + 1u) {
+    const size_t limit = PFX__LIMIT(p->dir), k = PFX__END_LEN(p->dir);
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
     for (;;) {
-        size_t start = pfx__find(p->buf, 0u, p->n, PFX__START), end, restart;
+        size_t start = pfx__find(p->buf, 0u, p->n), end, restart;
         if (start == p->n) {
             p->n = 0u;
             return 0;
         }
         pfx__drop(p, start);
-        end = pfx__find_end(p->buf, 1u, p->n);
-        restart = pfx__find(p->buf, 1u, p->n, PFX__START);
+        end = pfx__find_end(p->buf, 1u, p->n, p->dir);
+        restart = pfx__find(p->buf, 1u, p->n);
         if (end == p->n || restart < end) {
             if (restart < p->n) {
                 p->errors++;
@@ -967,7 +1087,7 @@ static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 
 void pfx_parser_gap(pfx_parser_t *parser)
 {
-    if (parser->n > 0u) { /* it begins with the start character */
+    if (parser->n > 0u) { /* it begins with a start character */
         parser->errors++;
     }
     parser->n = 0u;
@@ -985,14 +1105,14 @@ LINES_PUSH = Piece(
  * that does not decode is dropped. */
 static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
 {
-    const size_t k = sizeof(pfx__end) - 1u;
+    const size_t k = PFX__END_LEN(p->dir), limit = PFX__LIMIT(p->dir);
     size_t from = 0u, i;
     int r;
-    if (p->n < PFX__LIMIT + 1u) {
+    if (p->n < limit + 1u) {
         p->buf[p->n++] = byte;
     }
-    if (p->n < k || !pfx__same(p->buf + p->n - k, pfx__end, k)) { /* byte by byte: an ending is at the tail */
-        if (p->n > PFX__LIMIT) {
+    if (p->n < k || !pfx__same(p->buf + p->n - k, PFX__END(p->dir), k)) { /* byte by byte: an ending is at the tail */
+        if (p->n > limit) {
             p->errors++;
             for (i = 0u; i + 1u < k; i++) { /* keep what may begin a line ending */
                 p->buf[i] = p->buf[p->n - (k - 1u) + i];

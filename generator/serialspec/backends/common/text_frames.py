@@ -1,5 +1,5 @@
-"""What of a text protocol (`framing: {kind: text}`) the C and Wireshark targets cannot generate yet: one list, so the
-two say the same one line (backends.Unsupported) for the same spec."""
+"""What of a text protocol (`framing: {kind: text}`) a target cannot generate yet: one list, so the targets say the
+same one line (backends.Unsupported) for the same spec."""
 
 from __future__ import annotations
 
@@ -8,12 +8,12 @@ from collections.abc import Collection
 from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
-# what of the list each target generates
-C_TAKES = frozenset({"lines", "decimal", "separated", "values_only", "high_end"})
-WIRESHARK_TAKES = frozenset(
-    {"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "enclosed", "rest"}
-    | {"one_way", "starts", "address"}
+# what of the list each target generates: the C everything but labelled message text, the Wireshark dissector all
+C_TAKES = frozenset(
+    {"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest", "one_way"}
+    | {"starts", "address"}
 )
+WIRESHARK_TAKES = C_TAKES | {"labels"}
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
@@ -21,9 +21,10 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
     it the target does ("lines": frames without a start character, "decimal": a checksum written in decimal,
     "separated": a separator before the checksum, "values_only": replies of values alone, "high_end": a line ending
     with bytes above 0x7F, "ends": a line ending of its own for each direction, "codes": a reply under a code of its
-    own, "layouts": messages in their own text found by their code alone, without labels, "enclosed": messages in
-    their own text with a start or labels, "rest": a text field to the end of the line, "one_way": a checksum in one
-    direction only, "starts": a start of its own for each direction, "address": an address before the text code)."""
+    own, "layouts": messages in their own text (found by their code alone, or inside a start and an ending),
+    "labels": messages in their own text with labels, "rest": a text field to the end of the line, "one_way": a
+    checksum in one direction only, "starts": a start of its own for each direction, "address": an address before
+    the code)."""
     if not text.start and "lines" not in takes:
         raise Unsupported("text frames without a start character (every line a frame)")
     if any(c > "\x7f" for c in text.end) and "high_end" not in takes:
@@ -36,9 +37,8 @@ def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:
         raise Unsupported("a reply under a code of its own (`text: {code: ...}`)")
     if any(m.layout is not None for m in text.messages) and "layouts" not in takes:
         raise Unsupported("a message's own text layout (`text:`)")
-    enclosed = any(m.layout is not None and (m.layout.start or m.layout.labelled) for m in text.messages)
-    if enclosed and "enclosed" not in takes:
-        raise Unsupported("a message's own text with a start or labels (`text: {start: ...}`, `text: {named: ...}`)")
+    if any(m.layout is not None and m.layout.labelled for m in text.messages) and "labels" not in takes:
+        raise Unsupported("a message's own text with labels (`text: {named: ...}`)")
     # (a target that reads each line alone: a line of values names no message)
     if any(m.values_only for m in text.messages) and "values_only" not in takes:
         raise Unsupported("a reply of values alone (`values_only`), read only with the request it answers")

@@ -1,8 +1,8 @@
 """Nextion HMI, tried by a new user from the Instruction Set: text instructions ended by three 0xFF bytes (`page 1`,
 `get n0.val`, `dim=50`). A line ending holding bytes above 0x7F was a traceback in `serialspec encode` (the frame
-was encoded as ASCII): now it is bytes, read and written by the codec, the stream parser and the CLI, and refused by
-the C target and the dissector in one line. The display's binary replies (`71` + u32 LE + FF FF FF) are a strict
-xfail naming the gap. tests/specs/nextion.yaml; the package is generated once."""
+was encoded as ASCII): now it is bytes, read and written by the codec, the stream parser, the CLI and the dissector
+(the C target refuses the spec for its own text layouts, in one line). The display's binary replies (`71` + u32 LE
++ FF FF FF) are a strict xfail naming the gap. tests/specs/nextion.yaml; the package is generated once."""
 
 from __future__ import annotations
 
@@ -45,23 +45,20 @@ def test_the_cli_encodes_and_decodes_them() -> None:
     assert lines[0] == "70 61 67 65 20 31 ff ff ff" and "dim" in lines[1], lines
 
 
-def test_the_dissector_refuses_such_a_line_ending_and_the_c_target_takes_it() -> None:
-    """The C reads a line ending above 0x7F (tests/test_c_text.py holds it to Python); it refuses the spec for its
-    replies' own text layouts (`text:`), which it does not generate yet."""
+def test_the_dissector_takes_such_a_line_ending_and_the_c_target_refuses_the_layouts() -> None:
+    """The dissector reads the spec as it is (every line a frame, ended by FF FF FF: tests/test_wireshark_text.py holds
+    such a line ending to decode under tshark); the C reads the line ending (tests/test_c_text.py) but refuses the
+    spec for its messages' own text layouts (`text:`), which it does not generate yet."""
     from serialspec.backends import Unsupported, emitters
     from serialspec.lang.loader import load_text
     from serialspec.lang.resolve import resolve
 
-    text = SPEC.read_text("utf-8").replace("  separator:", '  start: "%"\n  separator:')
-    protocol = resolve(load_text(text, "nextion.yaml"))
-    said = {
-        "wireshark": r"^a line ending with bytes above 0x7F \(`end`\)$",
-        "c": r"^a message's own text layout \(`text:`\)$",
-    }
-    for emitter in emitters():
-        if emitter.name in said:
-            with pytest.raises(Unsupported, match=said[emitter.name]):
-                emitter.files(protocol)
+    protocol = resolve(load_text(SPEC.read_text("utf-8"), "nextion.yaml"))
+    by_name = {emitter.name: emitter for emitter in emitters()}
+    lua = by_name["wireshark"].files(protocol)["nextion/nextion.lua"]
+    assert 'ending = "\\xff\\xff\\xff"' in lua
+    with pytest.raises(Unsupported, match=r"^a message's own text layout \(`text:`\)$"):
+        by_name["c"].files(protocol)
 
 
 @pytest.mark.xfail(

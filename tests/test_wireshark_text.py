@@ -129,9 +129,9 @@ ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators
     "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
 }
 # Messages in their own text: inside a start and an ending, with labels, a list and a value after the code (GRBL's
-# `<Idle|MPos:…>`); found by their code, glued to it (LSS's `D1800`) beside a longer code, with their own separator
-# and list (Roboteq's `A=12:13`); labels glued to their values, with a separator (G-code's `X10.5`) and without
-# (LSS's `D1800T1500`).
+# `<Idle|MPos:…>`), or with a text to the end of the message's own text; found by their code, glued to it (LSS's
+# `D1800`) beside a longer code, with their own separator and list (Roboteq's `A=12:13`); labels glued to their
+# values, with a separator (G-code's `X10.5`) and without (LSS's `D1800T1500`).
 LAYOUTS = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_layouts"}
 LAYOUTS["commands"] |= {
     "report": {
@@ -150,6 +150,14 @@ LAYOUTS["commands"] |= {
                 },
                 "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
             },
+        },
+    },
+    "boxed": {  # a text to the end of its own text, its ending not included
+        "code": "BX",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "(", "end": ")", "separator": "|"},
+            "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}},
         },
     },
     "glued": {

@@ -445,7 +445,8 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
   local text = data:sub(body, stop)
   for _, layout in ipairs(SPEC.layouts) do
     if text:sub(1, #layout.start) == layout.start and ends_with(text:sub(#layout.start + 1), layout.ending) then
-      parts = split(data, body + #layout.start, stop - #layout.ending, layout.separator)
+      stop = stop - #layout.ending -- a text to the end of the line ends before the layout's ending
+      parts = split(data, body + #layout.start, stop, layout.separator)
       local first = parts[1]
       talker = first[2]:sub(1, SPEC.talker)
       local after = first[2]:sub(SPEC.talker + 1)

@@ -18,6 +18,7 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.text import TextField
 from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
 from test_language_matrix import TEXT_CASE
@@ -199,6 +200,20 @@ BY_DIRECTION = {
     "ws_text_one_way": ONE_WAY,
     "ws_text_layouts": LAYOUTS,
 }
+# Sentences decode refuses (their text between start and checksum, all responses) and the one line the dissector
+# says of each (its expert note), with no Lua file and line in it.
+MALFORMED = {
+    "ws_text_layouts": [
+        ("<ARP=1|Q=1>", "report: unknown label 'Q' (expected one of RP, LV, P, S)"),
+        ("<ARP=1|LV=1|LV=2>", "report: label 'LV' sent twice"),
+        ("<ARP=1|P=1>", "report: pos has 1 values, expected 2"),
+        ("<ARP|S=1,N,2,S,3,N,4,S>", "report: sats has 8 values, at most 6"),
+        ("<ARP|S=1>", "report: sats has 1 values, expected a multiple of 2"),
+        ("<AEV>", "every is not sent as <…>"),
+        ("<AZZ>", "unknown text code 'ZZ'"),
+        ("AZZ;1", "unknown text code 'ZZ'"),
+    ],
+}
 
 
 @pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
@@ -264,3 +279,15 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
                 assert "checksum_ok" not in got, got
 
     shown_as_decoded()
+    if name not in MALFORMED:
+        return
+    lines = [f"# serialspec capture: {name}"]
+    for body, _ in MALFORMED[name]:
+        with pytest.raises(DecodeError):
+            framing.decode(framing.frame(body, "response"), "response")
+        lines.append(f"2026-11-25T10:00:00.000000+00:00 response {framing.frame(body, 'response').hex(' ')}")
+    (tmp_path / "m.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    run(*CLI, "export", str(tmp_path / "m.capture"), "--pcap", str(tmp_path / "m.pcap"))
+    xml = run(TSHARK, "-X", script, "-r", str(tmp_path / "m.pcap"), "-T", "pdml")
+    said = [f.get("showname") for f in ET.fromstring(xml).iter("field") if f.get("name") == f"{name}.malformed"]
+    assert said == [line for _, line in MALFORMED[name]]

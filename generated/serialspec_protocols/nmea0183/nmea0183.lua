@@ -365,8 +365,15 @@ local function add_labelled(root, tvb, data, message, labelled, address_part)
   local layout, values = message.layout, {}
   for _, pair in ipairs(labelled) do
     local label, value, found = pair[1], pair[2], pair[3]
-    if not found or not layout.labelled[label] then error(message.command .. ": unknown label " .. label) end
-    if values[label] then error(message.command .. ": label " .. label .. " sent twice") end
+    if not found or not layout.labelled[label] then
+      local expected = {}
+      for _, item in ipairs(message.fields) do
+        if not item.address then expected[#expected + 1] = item.label end
+      end
+      error(string.format("%s: unknown label '%s' (expected one of %s)", message.command, label,
+        table.concat(expected, ", ")), 0)
+    end
+    if values[label] then error(string.format("%s: label '%s' sent twice", message.command, label), 0) end
     values[label] = value
   end
   for _, item in ipairs(message.fields) do
@@ -375,9 +382,12 @@ local function add_labelled(root, tvb, data, message, labelled, address_part)
       add_field(root, tvb, item.pf, address_part)
     elseif item.fields then
       local texts, size = value and cut(data, value, layout.list) or {}, #item.fields
-      if #texts % size ~= 0 or (value and item.count > 0 and #texts ~= item.count * size)
-        or (item.max and item.max > 0 and #texts > item.max * size) then
-        error(string.format("%s: %s has %d values", message.command, item.name, #texts))
+      if #texts % size ~= 0 or (value and item.count > 0 and #texts ~= item.count * size) then
+        local expected = item.count > 0 and tostring(item.count * size) or ("a multiple of " .. size)
+        error(string.format("%s: %s has %d values, expected %s", message.command, item.name, #texts, expected), 0)
+      end
+      if item.max > 0 and #texts > item.max * size then
+        error(string.format("%s: %s has %d values, at most %d", message.command, item.name, #texts, item.max * size), 0)
       end
       for k = 1, #texts, size do
         for i, inner in ipairs(item.fields) do add_field(root, tvb, inner.pf, texts[k + i - 1]) end
@@ -455,9 +465,9 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
       if named then code = after:sub(1, named - 1) end
       local by_direction = SPEC.messages[code]
       message = by_direction and by_direction[by_direction.only or direction]
-      if message == nil then error("unknown text code " .. code) end
+      if message == nil then error("unknown text code '" .. code .. "'", 0) end
       if message.layout == nil or message.layout.id ~= layout.id then
-        error(message.command .. " is not sent as " .. layout.start .. "…" .. layout.ending)
+        error(message.command .. " is not sent as " .. layout.start .. "…" .. layout.ending, 0)
       end
       head, head_size = first[1], #first[2]
       if SPEC.talker > 0 then root:add(f_talker, tvb(first[1] - 1, #talker), talker) end
@@ -511,7 +521,7 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
     message = by_direction and by_direction[by_direction.only or direction]
     if message == nil then
       root:add(f_code, tvb(parts[1][1] - 1, #address), code)
-      root:add_proto_expert_info(e_malformed, "unknown text code " .. code)
+      root:add_proto_expert_info(e_malformed, "unknown text code '" .. code .. "'")
       info[#info + 1] = "unknown " .. code
       return nil
     end

@@ -201,7 +201,7 @@ BY_DIRECTION = {
     "ws_text_layouts": LAYOUTS,
 }
 # Sentences decode refuses (their text between start and checksum, all responses) and the one line the dissector
-# says of each (its expert note), with no Lua file and line in it.
+# says of each (its expert note, on the sentence's own item), with no Lua file and line in it.
 MALFORMED = {
     "ws_text_layouts": [
         ("<ARP=1|Q=1>", "report: unknown label 'Q' (expected one of RP, LV, P, S)"),
@@ -291,3 +291,4 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
     xml = run(TSHARK, "-X", script, "-r", str(tmp_path / "m.pcap"), "-T", "pdml")
     said = [f.get("showname") for f in ET.fromstring(xml).iter("field") if f.get("name") == f"{name}.malformed"]
     assert said == [line for _, line in MALFORMED[name]]
+    assert len(sentences(xml, name)) == len(MALFORMED[name])  # each one item, what was read of it and its note

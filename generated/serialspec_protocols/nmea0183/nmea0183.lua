@@ -415,10 +415,9 @@ local function verify(written, covered)
   return #written == SPEC.digits and written:match("^%x+$") ~= nil and tonumber(written, 16) == value
 end
 
--- one sentence at data[first..last] (its start at first, the line ending left out); `asked`: the code of the request
--- before it in the capture (a reply of values alone is read as that request's reply)
-local function dissect_sentence(tvb, data, first, last, size, tree, direction, info, asked)
-  local root = tree:add(proto, tvb(first - 1, size))
+-- one sentence at data[first..last] (its start at first, the line ending left out) under its tree item `root`;
+-- `asked`: the code of the request before it in the capture (a reply of values alone is read as that request's reply)
+local function dissect_sentence(tvb, data, first, last, root, direction, info, asked)
   local body, stop, checked = first + #start_of(direction), last, nil
   if SPEC.checksum and SPEC.checksummed[direction] then
     local marker = nil
@@ -551,11 +550,11 @@ end
 
 -- the sentence at data[first..stop - 1] (its line ending after it): the message read, or nil
 local function sentence_at(tvb, data, first, stop, tree, direction, info, request)
-  local size = stop + #ending_of(direction) - first
-  local done, message = pcall(dissect_sentence, tvb, data, first, stop - 1, size, tree, direction, info, request)
-  if not done then
-    local item = tree:add(proto, tvb(first - 1, size))
-    item:add_proto_expert_info(e_malformed, tostring(message))
+  local root = tree:add(proto, tvb(first - 1, stop + #ending_of(direction) - first))
+  local done, message = pcall(dissect_sentence, tvb, data, first, stop - 1, root, direction, info, request)
+  if not done then -- shown on the sentence's own item, beside what was read of it
+    root:add_proto_expert_info(e_malformed, tostring(message))
+    info[#info + 1] = "malformed"
     return nil
   end
   return message

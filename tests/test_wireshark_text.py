@@ -292,3 +292,5 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
     said = [f.get("showname") for f in ET.fromstring(xml).iter("field") if f.get("name") == f"{name}.malformed"]
     assert said == [line for _, line in MALFORMED[name]]
     assert len(sentences(xml, name)) == len(MALFORMED[name])  # each one item, what was read of it and its note
+    items = [p.get("showname") for p in ET.fromstring(xml).iter("proto") if p.get("name") == name]
+    assert items[0] == f"{LAYOUTS['title']} response report", items  # an untitled command's item names it

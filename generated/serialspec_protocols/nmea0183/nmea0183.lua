@@ -588,6 +588,8 @@ local function dissect(tvb, pinfo, tree, direction_code)
     if restart and (stop == nil or restart < stop) then
       tree:add(f_garbage, tvb(first - 1, restart - first)):add_proto_expert_info(e_malformed, "cut short")
       pos = restart
+    elseif stop == nil and start == "" and data:sub(first):match("^[\r\n]+$") then
+      break -- CR or LF after the last line: the rest of a longer line ending or a blank line, never a sentence
     elseif stop == nil then
       tree:add(f_incomplete, tvb(first - 1))
       info[#info + 1] = "sentence continues"

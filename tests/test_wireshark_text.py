@@ -300,3 +300,30 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
     assert len(sentences(xml, name)) == len(MALFORMED[name])  # each one item, what was read of it and its note
     items = [p.get("showname") for p in ET.fromstring(xml).iter("proto") if p.get("name") == name]
     assert items[0] == f"{LAYOUTS['title']} response report", items  # an untitled command's item names it
+
+
+@pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
+def test_tshark_reads_a_blank_line_cut_before_its_prompt(tmp_path: Path) -> None:
+    """ELM327's replies end with CR CR `>` (every line a frame): a blank line's CR CR ending one packet and its `>`
+    beginning the next is no sentence, and the reply after it is read as decode reads it (once the CR CR was dropped
+    and the `>` read as the start of the next reply's code)."""
+    from serialspec import cli
+    from serialspec.backends import emitters
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    spec = Path(__file__).parent / "specs" / "elm327.yaml"
+    protocol = resolve(load_text(spec.read_text("utf-8"), "elm327.yaml"))
+    wireshark = next(e for e in emitters() if e.name == "wireshark")
+    (tmp_path / "elm327.lua").write_text(wireshark.files(protocol)["elm327/elm327.lua"], encoding="utf-8")
+    reply = b"41 0C 1A F8 \r\r>"
+    lines = ["# serialspec capture: elm327"]
+    lines += [f"2026-11-25T10:00:00.000000+00:00 response {p.hex(' ')}" for p in (reply, b"\r\r", b">", reply)]
+    (tmp_path / "t.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    assert cli.main(["export", str(tmp_path / "t.capture"), "--pcap", str(tmp_path / "t.pcap")]) == 0
+    xml = run(TSHARK or "", "-X", f"lua_script:{tmp_path / 'elm327.lua'}", "-r", str(tmp_path / "t.pcap"), "-T", "pdml")
+    fields = [(f.get("command"), f["fields"]) for f in sentences(xml, "elm327")]
+    assert fields == [("engine_rpm", [("a", "1A"), ("b", "F8")])] * 2, fields
+    assert not [
+        f for f in ET.fromstring(xml).iter("field") if f.get("name") in ("elm327.incomplete", "elm327.malformed")
+    ]

@@ -589,7 +589,15 @@ local function dissect(tvb, pinfo, tree, direction_code)
       tree:add(f_garbage, tvb(first - 1, restart - first)):add_proto_expert_info(e_malformed, "cut short")
       pos = restart
     elseif stop == nil and start == "" and data:sub(first):match("^[\r\n]+$") then
-      break -- CR or LF after the last line: the rest of a longer line ending or a blank line, never a sentence
+      -- CR or LF after the last line: the rest of a longer line ending or a blank line, never a sentence; what may
+      -- begin a line ending (ELM327's CR CR then `>`) goes before the next packet, unshown
+      for k = math.min(#data - first + 1, #ending - 1), 1, -1 do
+        if data:sub(#data - k + 1) == ending:sub(1, k) then
+          if not pinfo.visited then pending[direction_code] = data:sub(#data - k + 1) end
+          break
+        end
+      end
+      break
     elseif stop == nil then
       tree:add(f_incomplete, tvb(first - 1))
       info[#info + 1] = "sentence continues"

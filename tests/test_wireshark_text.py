@@ -18,6 +18,7 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.text import TextField
 from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
 from test_language_matrix import TEXT_CASE
@@ -130,9 +131,9 @@ ONE_WAY["commands"]["note"] = {  # and a text to the end of the line, separators
     "response": {"unsolicited": True, "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}}},
 }
 # Messages in their own text: inside a start and an ending, with labels, a list and a value after the code (GRBL's
-# `<Idle|MPos:…>`); found by their code, glued to it (LSS's `D1800`) beside a longer code, with their own separator
-# and list (Roboteq's `A=12:13`); labels glued to their values, with a separator (G-code's `X10.5`) and without
-# (LSS's `D1800T1500`).
+# `<Idle|MPos:…>`), or with a text to the end of the message's own text; found by their code, glued to it (LSS's
+# `D1800`) beside a longer code, with their own separator and list (Roboteq's `A=12:13`); labels glued to their
+# values, with a separator (G-code's `X10.5`) and without (LSS's `D1800T1500`).
 LAYOUTS = copy.deepcopy(TEXT_CASE) | {"protocol": "ws_text_layouts"}
 LAYOUTS["commands"] |= {
     "report": {
@@ -151,6 +152,14 @@ LAYOUTS["commands"] |= {
                 },
                 "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
             },
+        },
+    },
+    "boxed": {  # a text to the end of its own text, its ending not included
+        "code": "BX",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "(", "end": ")", "separator": "|"},
+            "fields": {"n": "integer", "msg": {"type": "text", "size": "rest"}},
         },
     },
     "glued": {
@@ -191,6 +200,20 @@ BY_DIRECTION = {
     "ws_text_lines": copy.deepcopy(LINES) | {"protocol": "ws_text_lines"},
     "ws_text_one_way": ONE_WAY,
     "ws_text_layouts": LAYOUTS,
+}
+# Sentences decode refuses (their text between start and checksum, all responses) and the one line the dissector
+# says of each (its expert note, on the sentence's own item), with no Lua file and line in it.
+MALFORMED = {
+    "ws_text_layouts": [
+        ("<ARP=1|Q=1>", "report: unknown label 'Q' (expected one of RP, LV, P, S)"),
+        ("<ARP=1|LV=1|LV=2>", "report: label 'LV' sent twice"),
+        ("<ARP=1|P=1>", "report: pos has 1 values, expected 2"),
+        ("<ARP|S=1,N,2,S,3,N,4,S>", "report: sats has 8 values, at most 6"),
+        ("<ARP|S=1>", "report: sats has 1 values, expected a multiple of 2"),
+        ("<AEV>", "every is not sent as <…>"),
+        ("<AZZ>", "unknown text code 'ZZ'"),
+        ("AZZ;1", "unknown text code 'ZZ'"),
+    ],
 }
 
 
@@ -241,12 +264,18 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
             marker = first.rfind(framing.marker.encode())
             packets.append((first_direction, first[: marker + 1] + b"ZZ" + first[marker + 3 :]))
             wanted.append(wanted[0] | {"checksum_ok": False})
+        if not framing.start:  # a blank line cut across packets (CR ends one, LF begins the next): no sentence
+            after = next(i for i, (d, _) in enumerate(packets) if i and d == first_direction)
+            packets[0], packets[after] = (first_direction, first + b"\r"), (first_direction, b"\n" + packets[after][1])
         lines = [f"# serialspec capture: {name}"]
         lines += [f"2026-11-25T10:00:00.000000+00:00 {d} {f.hex(' ')}" for d, f in packets]
         (tmp_path / "t.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
         run(*CLI, "export", str(tmp_path / "t.capture"), "--pcap", str(tmp_path / "t.pcap"))
-        seen = sentences(run(TSHARK, "-X", script, "-r", str(tmp_path / "t.pcap"), "-T", "pdml"), name)
+        xml = run(TSHARK, "-X", script, "-r", str(tmp_path / "t.pcap"), "-T", "pdml")
+        seen = sentences(xml, name)
         assert len(seen) == len(wanted), seen
+        # one sentence continues in the next packet: the one cut across two
+        assert [f.get("name") for f in ET.fromstring(xml).iter("field")].count(f"{name}.incomplete") == 1
         for got, expected in zip(seen, wanted, strict=True):
             assert got["command"] == expected["command"] and got["direction"] == expected["direction"], got
             assert got.get("talker", "") == expected["talker"]
@@ -257,3 +286,45 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
                 assert "checksum_ok" not in got, got
 
     shown_as_decoded()
+    if name not in MALFORMED:
+        return
+    lines = [f"# serialspec capture: {name}"]
+    for body, _ in MALFORMED[name]:
+        with pytest.raises(DecodeError):
+            framing.decode(framing.frame(body, "response"), "response")
+        lines.append(f"2026-11-25T10:00:00.000000+00:00 response {framing.frame(body, 'response').hex(' ')}")
+    (tmp_path / "m.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    run(*CLI, "export", str(tmp_path / "m.capture"), "--pcap", str(tmp_path / "m.pcap"))
+    xml = run(TSHARK, "-X", script, "-r", str(tmp_path / "m.pcap"), "-T", "pdml")
+    said = [f.get("showname") for f in ET.fromstring(xml).iter("field") if f.get("name") == f"{name}.malformed"]
+    assert said == [line for _, line in MALFORMED[name]]
+    assert len(sentences(xml, name)) == len(MALFORMED[name])  # each one item, what was read of it and its note
+    items = [p.get("showname") for p in ET.fromstring(xml).iter("proto") if p.get("name") == name]
+    assert items[0] == f"{LAYOUTS['title']} response report", items  # an untitled command's item names it
+
+
+@pytest.mark.skipif(TSHARK is None, reason="tshark is not installed")
+def test_tshark_reads_a_blank_line_cut_before_its_prompt(tmp_path: Path) -> None:
+    """ELM327's replies end with CR CR `>` (every line a frame): a blank line's CR CR ending one packet and its `>`
+    beginning the next is no sentence, and the reply after it is read as decode reads it (once the CR CR was dropped
+    and the `>` read as the start of the next reply's code)."""
+    from serialspec import cli
+    from serialspec.backends import emitters
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    spec = Path(__file__).parent / "specs" / "elm327.yaml"
+    protocol = resolve(load_text(spec.read_text("utf-8"), "elm327.yaml"))
+    wireshark = next(e for e in emitters() if e.name == "wireshark")
+    (tmp_path / "elm327.lua").write_text(wireshark.files(protocol)["elm327/elm327.lua"], encoding="utf-8")
+    reply = b"41 0C 1A F8 \r\r>"
+    lines = ["# serialspec capture: elm327"]
+    lines += [f"2026-11-25T10:00:00.000000+00:00 response {p.hex(' ')}" for p in (reply, b"\r\r", b">", reply)]
+    (tmp_path / "t.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    assert cli.main(["export", str(tmp_path / "t.capture"), "--pcap", str(tmp_path / "t.pcap")]) == 0
+    xml = run(TSHARK or "", "-X", f"lua_script:{tmp_path / 'elm327.lua'}", "-r", str(tmp_path / "t.pcap"), "-T", "pdml")
+    fields = [(f.get("command"), f["fields"]) for f in sentences(xml, "elm327")]
+    assert fields == [("engine_rpm", [("a", "1A"), ("b", "F8")])] * 2, fields
+    assert not [
+        f for f in ET.fromstring(xml).iter("field") if f.get("name") in ("elm327.incomplete", "elm327.malformed")
+    ]

@@ -365,8 +365,15 @@ local function add_labelled(root, tvb, data, message, labelled, address_part)
   local layout, values = message.layout, {}
   for _, pair in ipairs(labelled) do
     local label, value, found = pair[1], pair[2], pair[3]
-    if not found or not layout.labelled[label] then error(message.command .. ": unknown label " .. label) end
-    if values[label] then error(message.command .. ": label " .. label .. " sent twice") end
+    if not found or not layout.labelled[label] then
+      local expected = {}
+      for _, item in ipairs(message.fields) do
+        if not item.address then expected[#expected + 1] = item.label end
+      end
+      error(string.format("%s: unknown label '%s' (expected one of %s)", message.command, label,
+        table.concat(expected, ", ")), 0)
+    end
+    if values[label] then error(string.format("%s: label '%s' sent twice", message.command, label), 0) end
     values[label] = value
   end
   for _, item in ipairs(message.fields) do
@@ -375,9 +382,12 @@ local function add_labelled(root, tvb, data, message, labelled, address_part)
       add_field(root, tvb, item.pf, address_part)
     elseif item.fields then
       local texts, size = value and cut(data, value, layout.list) or {}, #item.fields
-      if #texts % size ~= 0 or (value and item.count > 0 and #texts ~= item.count * size)
-        or (item.max and item.max > 0 and #texts > item.max * size) then
-        error(string.format("%s: %s has %d values", message.command, item.name, #texts))
+      if #texts % size ~= 0 or (value and item.count > 0 and #texts ~= item.count * size) then
+        local expected = item.count > 0 and tostring(item.count * size) or ("a multiple of " .. size)
+        error(string.format("%s: %s has %d values, expected %s", message.command, item.name, #texts, expected), 0)
+      end
+      if item.max > 0 and #texts > item.max * size then
+        error(string.format("%s: %s has %d values, at most %d", message.command, item.name, #texts, item.max * size), 0)
       end
       for k = 1, #texts, size do
         for i, inner in ipairs(item.fields) do add_field(root, tvb, inner.pf, texts[k + i - 1]) end
@@ -405,10 +415,9 @@ local function verify(written, covered)
   return #written == SPEC.digits and written:match("^%x+$") ~= nil and tonumber(written, 16) == value
 end
 
--- one sentence at data[first..last] (its start at first, the line ending left out); `asked`: the code of the request
--- before it in the capture (a reply of values alone is read as that request's reply)
-local function dissect_sentence(tvb, data, first, last, size, tree, direction, info, asked)
-  local root = tree:add(proto, tvb(first - 1, size))
+-- one sentence at data[first..last] (its start at first, the line ending left out) under its tree item `root`;
+-- `asked`: the code of the request before it in the capture (a reply of values alone is read as that request's reply)
+local function dissect_sentence(tvb, data, first, last, root, direction, info, asked)
   local body, stop, checked = first + #start_of(direction), last, nil
   if SPEC.checksum and SPEC.checksummed[direction] then
     local marker = nil
@@ -445,7 +454,8 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
   local text = data:sub(body, stop)
   for _, layout in ipairs(SPEC.layouts) do
     if text:sub(1, #layout.start) == layout.start and ends_with(text:sub(#layout.start + 1), layout.ending) then
-      parts = split(data, body + #layout.start, stop - #layout.ending, layout.separator)
+      stop = stop - #layout.ending -- a text to the end of the line ends before the layout's ending
+      parts = split(data, body + #layout.start, stop, layout.separator)
       local first = parts[1]
       talker = first[2]:sub(1, SPEC.talker)
       local after = first[2]:sub(SPEC.talker + 1)
@@ -454,9 +464,9 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
       if named then code = after:sub(1, named - 1) end
       local by_direction = SPEC.messages[code]
       message = by_direction and by_direction[by_direction.only or direction]
-      if message == nil then error("unknown text code " .. code) end
+      if message == nil then error("unknown text code '" .. code .. "'", 0) end
       if message.layout == nil or message.layout.id ~= layout.id then
-        error(message.command .. " is not sent as " .. layout.start .. "…" .. layout.ending)
+        error(message.command .. " is not sent as " .. layout.start .. "…" .. layout.ending, 0)
       end
       head, head_size = first[1], #first[2]
       if SPEC.talker > 0 then root:add(f_talker, tvb(first[1] - 1, #talker), talker) end
@@ -510,7 +520,7 @@ local function dissect_sentence(tvb, data, first, last, size, tree, direction, i
     message = by_direction and by_direction[by_direction.only or direction]
     if message == nil then
       root:add(f_code, tvb(parts[1][1] - 1, #address), code)
-      root:add_proto_expert_info(e_malformed, "unknown text code " .. code)
+      root:add_proto_expert_info(e_malformed, "unknown text code '" .. code .. "'")
       info[#info + 1] = "unknown " .. code
       return nil
     end
@@ -540,11 +550,11 @@ end
 
 -- the sentence at data[first..stop - 1] (its line ending after it): the message read, or nil
 local function sentence_at(tvb, data, first, stop, tree, direction, info, request)
-  local size = stop + #ending_of(direction) - first
-  local done, message = pcall(dissect_sentence, tvb, data, first, stop - 1, size, tree, direction, info, request)
-  if not done then
-    local item = tree:add(proto, tvb(first - 1, size))
-    item:add_proto_expert_info(e_malformed, tostring(message))
+  local root = tree:add(proto, tvb(first - 1, stop + #ending_of(direction) - first))
+  local done, message = pcall(dissect_sentence, tvb, data, first, stop - 1, root, direction, info, request)
+  if not done then -- shown on the sentence's own item, beside what was read of it
+    root:add_proto_expert_info(e_malformed, tostring(message))
+    info[#info + 1] = "malformed"
     return nil
   end
   return message
@@ -578,6 +588,16 @@ local function dissect(tvb, pinfo, tree, direction_code)
     if restart and (stop == nil or restart < stop) then
       tree:add(f_garbage, tvb(first - 1, restart - first)):add_proto_expert_info(e_malformed, "cut short")
       pos = restart
+    elseif stop == nil and start == "" and data:sub(first):match("^[\r\n]+$") then
+      -- CR or LF after the last line: the rest of a longer line ending or a blank line, never a sentence; what may
+      -- begin a line ending (ELM327's CR CR then `>`) goes before the next packet, unshown
+      for k = math.min(#data - first + 1, #ending - 1), 1, -1 do
+        if data:sub(#data - k + 1) == ending:sub(1, k) then
+          if not pinfo.visited then pending[direction_code] = data:sub(#data - k + 1) end
+          break
+        end
+      end
+      break
     elseif stop == nil then
       tree:add(f_incomplete, tvb(first - 1))
       info[#info + 1] = "sentence continues"

@@ -66,7 +66,7 @@ def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
             "command": m.key,
             "code": m.code,
             "direction": m.direction.value,
-            "title": m.title,
+            "title": m.title or m.key,  # the item of each sentence names it (the command where untitled)
             "fields": fields,
             "bare": m.values_only or None,  # read only right after its request (the last one before it in the capture)
         }

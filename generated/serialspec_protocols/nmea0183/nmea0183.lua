@@ -500,19 +500,17 @@ local function dissect_sentence(tvb, data, first, last, root, direction, info, a
     if SPEC.talker > 0 then root:add(f_talker, tvb(parts[1][1] - 1, SPEC.talker), talker) end
     root:add(f_code, tvb(code_at - 1, #own.code), own.code)
     message, at, head_size = own, 1, SPEC.talker + #own.code
-    if layout.glued then -- the code is the label of the value right after it, where a field has it as its label
-      local from = layout.labelled[own.code] and code_at or inner_first
-      labelled = labelled_pairs(data, layout, nil, from or code_at, inner_last or (code_at + #own.code - 1))
-      if inner_first == nil and not layout.labelled[own.code] then labelled = {} end
+    local has_fields = inner_first ~= nil and inner_last >= inner_first -- runtime/text.py: `inner` not empty
+    if layout.glued and layout.labelled[own.code] then -- the code is the label of the value right after it
+      labelled = labelled_pairs(data, layout, nil, code_at, inner_last or (code_at + #own.code - 1))
+    elseif layout.glued then
+      labelled = has_fields and labelled_pairs(data, layout, nil, inner_first, inner_last) or {}
     elseif layout.named ~= "" then
-      labelled = labelled_pairs(data, layout, inner_first and split(data, inner_first, inner_last, layout.separator)
-        or {})
+      labelled = has_fields and labelled_pairs(data, layout, split(data, inner_first, inner_last, layout.separator))
+        or {}
     else
-      parts = inner_first and pieces(data, inner_first, inner_last, layout.separator, layout.list) or {}
+      parts = has_fields and pieces(data, inner_first, inner_last, layout.separator, layout.list) or {}
       stop = inner_last or stop
-    end
-    if inner_first and inner_last < inner_first and not layout.glued then -- the text of its fields is empty
-      parts, labelled = {}, labelled and {} or nil
     end
   elseif direction == "response" and bare and bare.bare and not coded then
     message, at = bare, 1 -- a reply of values alone, right after its request: every part a field

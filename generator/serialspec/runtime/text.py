@@ -149,6 +149,11 @@ class TextLayout:
         """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
         return bool(self.named) or self.glued
 
+    @property
+    def follows_code(self) -> str:
+        """What is written between the code and the first field: `after_code`, else the separator."""
+        return self.separator if self.after_code is None else self.after_code
+
 
 @dataclass(frozen=True)
 class TextSentence:
@@ -354,7 +359,7 @@ class TextFraming:
             if matched and len(sentence.code) < len(matched[0][0].code):
                 break
             rest = text[len(sentence.code) :]
-            after = layout.separator if layout.after_code is None else layout.after_code
+            after = layout.follows_code
             if layout.glued and any(item.label == sentence.code for item in _sent(sentence)):
                 after = ""  # the value labelled with the code follows it (LSS's `D1800`)
             if not rest:
@@ -629,7 +634,7 @@ def _encode_in(
             continue  # a repeat of no groups (at the end, `max_count`): nothing, not an empty field
         joined = (layout.list or layout.separator).join(texts)
         parts.append(f"{item.label}{layout.named}{joined}" if layout.labelled else joined)
-    after = layout.separator if layout.after_code is None else layout.after_code
+    after = layout.follows_code
     joined = layout.separator.join(parts[1:])
     # found by its code alone: a frame whose fields have no text is the code alone
     fields = after + joined if len(parts) > 1 and (joined or layout.start) else ""

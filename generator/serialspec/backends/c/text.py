@@ -488,7 +488,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
         written = "\n".join(writes)
         if layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text
-            after = layout.separator if layout.after_code is None else layout.after_code
+            after = layout.follows_code
             written = (
                 f"    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);\n    fields = o->n;\n{written}\n"
                 f"    if ({'first' if layout.start else 'o->n == fields'}) {{ /* no field's text: the code alone */\n"
@@ -736,7 +736,7 @@ static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
         for m in alone:
             layout = m.layout
             assert layout is not None
-            after = layout.separator if layout.after_code is None else layout.after_code
+            after = layout.follows_code
             call = (
                 f"{self.call('alone')}(t, tn, {_c_string(m.code)}, {len(m.code)}u, {_c_string(after)}, {len(after)}u, "
                 f"{_c_string(layout.end)}, {len(layout.end)}u, &at, &inner)"
@@ -1347,7 +1347,7 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
         body = "\n".join(parts)
         if m.layout is not None:  # its own layout: the fields after the talker, code and what follows the code
             layout = m.layout
-            after = layout.separator if layout.after_code is None else layout.after_code
+            after = layout.follows_code
             body = (
                 (
                     f"    for (c.pos = 0u; c.pos < {text.talker}u && msg->talker[c.pos] != '\\0'; c.pos++) {{\n    }}\n"

@@ -63,6 +63,11 @@ class TextLayout:
         """Whether its fields are found by their labels (`named`, or labels glued to their values)."""
         return bool(self.named) or self.glued
 
+    @property
+    def follows_code(self) -> str:
+        """What is written between the code and the first field: `after_code`, else the separator."""
+        return self.separator if self.after_code is None else self.after_code
+
 
 @frozen
 class TextMessage:

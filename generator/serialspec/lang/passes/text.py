@@ -344,7 +344,7 @@ class TextPass(Pass):
             layout = message.layout
             if layout is None or layout.start:
                 continue
-            after = layout.separator if layout.after_code is None else layout.after_code
+            after = layout.follows_code
             sent = [f for f in message.fields if not (isinstance(f, TextField) and f.address)]
             first = sent[0] if sent else None
             # a decimal number (hex digits could go on as another code's letters)

@@ -206,7 +206,7 @@ def python_json(b: Built, sentence: Sentence) -> dict[str, Any]:
         "command": command,
         "subcommand": None,
         "direction": sentence.direction,
-        "talker": sentence.talker,
+        **({"talker": sentence.talker} if b.framing.talker else {}),
         "sent": sentence.sent,
         "fields": fields,
     }

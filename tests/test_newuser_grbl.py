@@ -273,6 +273,18 @@ def test_the_status_report_s_package(example: ModuleType) -> None:
         assert str(refused.value) == reason
 
 
+def test_a_protocol_without_a_talker_shows_none(example: ModuleType) -> None:
+    """GRBL's frames carry no talker: its messages neither show one nor take one as their first argument, and
+    `decode --json` names none (it used to print `ErrorResponse(talker='', code=3)` and `"talker": ""`)."""
+    from serialspec.cli.textframes import describe
+
+    grbl = example
+    error = grbl.decode(b"error:3\r\n")
+    assert repr(error) == "ErrorResponse(code=3)"
+    assert grbl.ErrorResponse(3) == error and grbl.encode(grbl.ErrorResponse(3)) == b"error:3\r\n"
+    assert "talker" not in describe("grbl", grbl, b"error:3\r\n")
+
+
 def test_codes_with_question_marks_compile_as_c99_without_trigraphs(tmp_path: Path) -> None:
     """`??=` in a C99 string literal is the trigraph `#`: the C target escapes `?` so that the code is sent as written
     (gcc -std=c99 -Wall reads trigraphs and warns about them)."""

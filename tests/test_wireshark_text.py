@@ -16,9 +16,9 @@ from typing import Any
 
 import pytest
 import yaml
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.text import TextField
 from test_c_text import CLI, LINES, NAMES, SPECS, Built, built, python_json
 from test_language_matrix import TEXT_CASE
@@ -53,6 +53,14 @@ def sentences(xml: str, name: str) -> list[dict[str, Any]]:
     return found
 
 
+def sendable(b: Built, s: Any, values: dict[str, Any], talker: str) -> bool:
+    try:
+        b.framing.encode(s.code, values, talker, direction=s.direction)
+    except EncodeError:
+        return False
+    return True
+
+
 def flat(fields: dict[str, Any]) -> list[tuple[str, str]]:
     """decode --json's fields in order, a repeat's groups as <repeat>.<field> one after another."""
     out: list[tuple[str, str]] = []
@@ -84,8 +92,10 @@ def test_tshark_shows_random_sentences_as_decode_does(name: str, tmp_path: Path)
         lines, wanted = [f"# serialspec capture: {name}"], []
         frames = []
         for s in b.framing.sentences:
-            values = data.draw(sentence_values(s))
-            frame = b.framing.encode(s.code, values, data.draw(st.sampled_from(talkers)), direction=s.direction)
+            talker = data.draw(st.sampled_from(talkers))
+            # values a frame can carry (a text holding an enclosing layout's end cannot be sent: encode refuses it)
+            values = data.draw(sentence_values(s).filter(lambda v, s=s, t=talker: sendable(b, s, v, t)))
+            frame = b.framing.encode(s.code, values, talker, direction=s.direction)
             frames.append((s.direction, frame))
             wanted.append(python_json(b, b.framing.decode(frame, s.direction)) | {"checksum_ok": True})
         direction, last = frames[-1]
@@ -106,7 +116,7 @@ def test_tshark_shows_random_sentences_as_decode_does(name: str, tmp_path: Path)
         assert len(seen) == len(wanted)
         for got, expected in zip(seen, wanted, strict=True):
             assert got["command"] == expected["command"] and got["direction"] == expected["direction"]
-            assert got.get("talker", "") == expected["talker"]
+            assert got.get("talker", "") == expected.get("talker", "")
             assert got["fields"] == flat(expected["fields"]), (got, expected)
             if b.framing.checksum is not None and expected["direction"] in b.framing.checksummed:
                 assert (got["checksum_ok"] in ("1", "True")) == expected["checksum_ok"], got
@@ -251,6 +261,7 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
                     # the value labelled with the code, right after it (GRBL's `Hold:0`, LSS's `D1800`)
                     values[item.name] = data.draw(field_values(item).filter(lambda v: v is not None))
             talker = data.draw(st.sampled_from(talkers))
+            assume(sendable(b, s, values, talker))  # a text holding an enclosing layout's end cannot be sent
             frame = framing.encode(s.code, values, talker, direction=s.direction)
             frames.append((s.direction, frame))
             decoded = framing.decode(frame, s.direction, asked if s.direction == "response" else None)
@@ -278,7 +289,7 @@ def test_tshark_shows_lines_and_each_directions_own_text_as_decode_does(name: st
         assert [f.get("name") for f in ET.fromstring(xml).iter("field")].count(f"{name}.incomplete") == 1
         for got, expected in zip(seen, wanted, strict=True):
             assert got["command"] == expected["command"] and got["direction"] == expected["direction"], got
-            assert got.get("talker", "") == expected["talker"]
+            assert got.get("talker", "") == expected.get("talker", "")
             assert got["fields"] == flat(expected["fields"]), (got, expected)
             if expected["direction"] in framing.checksummed and framing.checksum is not None:
                 assert (got["checksum_ok"] in ("1", "True")) == expected["checksum_ok"], got

@@ -40,12 +40,14 @@ def describe(
     sentence = framing.decode(frame, direction, reply)
     cls = package.CODEC.classes[sentence.code, sentence.direction]
     body = frame.decode("latin-1")  # ASCII, its line ending perhaps not
+    # the talker where the frames carry one (a protocol without has no such key)
+    talker = {"talker": sentence.talker} if framing.talker else {}
     return {
         "protocol": protocol,
         "direction": cls.DIRECTION.value,
         "command": cls.COMMAND,
         "subcommand": None,
-        "talker": sentence.talker,
+        **talker,
         "fields": texts(framing.sentence(sentence.code, sentence.direction), sentence.values),
         "sent": sentence.sent,
         # a frame whose checksum fails does not decode; one without a checksum (none in the framing, or left out
@@ -87,7 +89,7 @@ def decode(
 def readable(result: dict[str, Any]) -> str:
     when = f"{result['time']} " if result.get("time") else ""
     lines = [f"{when}{result['protocol']} {result['direction']} {result['command']}  {result['text']}"]
-    if result["talker"]:
+    if result.get("talker"):
         lines.append(f"  {'talker':<20} {result['talker']}")
     for name, value in result["fields"].items():
         if isinstance(value, list):

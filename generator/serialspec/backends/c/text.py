@@ -1382,9 +1382,15 @@ static void {p}__j_rest({p}__json_t *j, {p}__jcur_t *c)
     if text.address is not None:  # the address's digits, before the talker and code
         lead = "    while (lead < len && body[lead] >= 0x30u && body[lead] <= 0x39u) {\n        lead++;\n    }\n"
         lead += "    c.pos = lead;\n"
-    talker_length = "    i = 0u;"
+    # the talker, where the frames carry one (decode --json names none in a protocol without)
+    talker_json, sent_lead = "", ""
     if text.talker:
-        talker_length = f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}"
+        talker_json = (
+            f'    size_t i;\n    {p}__j_str(j, "\\"talker\\":");\n'
+            f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}\n"
+            f"    {p}__j_text(j, (const uint8_t *)msg->talker, i);\n"
+        )
+        sent_lead = ","
     return f"""{banner(protocol)}
 #include "{p}_json.h"
 
@@ -1460,11 +1466,7 @@ static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
 {rest}static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
 {{
     char number[40];
-    size_t i;
-    {p}__j_str(j, "\\"talker\\":");
-{talker_length}
-    {p}__j_text(j, (const uint8_t *)msg->talker, i);
-    (void)snprintf(number, sizeof(number), ",\\"sent\\":%d,\\"fields\\":{{", (int)msg->sent);
+{talker_json}    (void)snprintf(number, sizeof(number), "{sent_lead}\\"sent\\":%d,\\"fields\\":{{", (int)msg->sent);
     {p}__j_str(j, number);
 }}
 

@@ -347,8 +347,8 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         if text.talker:
             yield f"    #: {one_line(text.talker_description or 'The talker id.')}"
             yield f"    talker: str = {default_talker!r}"
-        else:
-            yield '    talker: str = ""'
+        else:  # no talker in these frames: the base's attribute, never an argument, never shown
+            yield '    talker: str = field(default="", init=False, compare=False, repr=False)'
         for item in message.fields:
             if isinstance(item, TextRepeat):
                 if item.description:

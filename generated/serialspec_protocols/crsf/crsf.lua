@@ -1445,9 +1445,9 @@ local function add_scalar(f, tree, range, scope)
     local top = 2 ^ (SIZES[f.type] * 8 - 1)
     if value >= top then value = -(value - top) end
     item = tree:add(f.pf, range, value)
-  elseif f.seven_bit then
-    value = seven_bit(value, SIZES[f.type])
-    if value == nil then error(string.format("%s: bit 7 of a byte is set", f.name), 0) end
+  elseif f.low_bits then
+    value = low_bits(value, SIZES[f.type], f.low_bits)
+    if value == nil then error(string.format("%s of a byte of %s is set", f.low_bits.flaw, f.name), 0) end
     item = tree:add(f.pf, range, value)
   else
     item = add(tree, f.pf, range, f.big)

@@ -41,6 +41,9 @@ def test_the_sim_answers_a_command_and_an_inquiry(visca: ModuleType) -> None:
     assert done == bytes.fromhex("90 51 ff")
     [(_, state)] = sim.feed(bytes.fromhex("81 09 04 00 ff"))
     assert state == bytes.fromhex("90 50 03 ff")
+    [(_, done)] = sim.feed(bytes.fromhex("81 01 04 47 0a 0b 0c 0d ff"))  # the zoom position, a nibble a byte
+    [(_, zoom)] = sim.feed(bytes.fromhex("81 09 04 47 ff"))
+    assert (done, zoom) == (bytes.fromhex("90 51 ff"), bytes.fromhex("90 50 0a 0b 0c 0d ff"))
 
 
 def test_positions_are_numbers_sent_a_nibble_a_byte(visca: ModuleType) -> None:

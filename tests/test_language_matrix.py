@@ -253,6 +253,9 @@ CASES: dict[str, Case] = {
             "p": {"type": "i32", "encoding": "nibbles", "range": [-32768, -1], "default": -2},  # (negative, always)
             "d": {"type": "i8", "encoding": "nibbles"},
             "o": {"type": "u24", "encoding": "nibbles", "endian": "big", "range": [0, 4000]},
+            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64 (a value of 32 bits, exact in Lua)
+            "u": {"type": "u64", "encoding": "nibbles", "endian": "big"},
+            "i": {"type": "i64", "encoding": "nibbles", "range": [-(2**31), -1], "default": -3},
         }
     ),
     # text of 14-bit characters (Firmata's STRING_DATA): fixed-size, in a group's items, and rest

@@ -887,9 +887,10 @@ local function add_scalar(f, tree, range, scope)
     if value >= top then value = -(value - top) end
     item = tree:add(f.pf, range, value)
   elseif f.low_bits then
-    value = low_bits(value, SIZES[f.type], f.low_bits)
+    value = low_bits(range, f.big, f.low_bits)
     if value == nil then error(string.format("%s of a byte of %s is set", f.low_bits.flaw, f.name), 0) end
-    item = tree:add(f.pf, range, value)
+    local wide = SIZES[f.type] == 8 and (f.low_bits.signed and Int64(value) or UInt64(value)) -- a 64-bit field's
+    item = tree:add(f.pf, range, wide or value)
   else
     item = add(tree, f.pf, range, f.big)
   end

@@ -91,15 +91,18 @@ class LowBits:
         return "(" + " | ".join(parts) + ")"
 
     def c_decode(self, raw: str, size: int, signed: bool) -> str:
-        """A C expression of the value (unsigned long; long when signed), from `raw`, the wire word (an unsigned
-        expression)."""
-        value = "(" + " | ".join(f"(({raw} >> {shift}) & 0x{mask:x}UL)" for shift, mask in self._parts(size)) + ")"
-        return f"((long)({value} ^ 0x{self._top(size):x}UL) - 0x{self._top(size):x}L)" if signed else value
+        """A C expression of the value (unsigned long, long when signed; of an 8-byte word, unsigned long long and
+        long long), from `raw`, the wire word (an unsigned expression)."""
+        u, s = ("ULL", "LL") if size > 4 else ("UL", "L")
+        value = "(" + " | ".join(f"(({raw} >> {shift}) & 0x{mask:x}{u})" for shift, mask in self._parts(size)) + ")"
+        top = self._top(size)
+        return f"((long{' long' * (size > 4)})({value} ^ 0x{top:x}{u}) - 0x{top:x}{s})" if signed else value
 
     def c_encode(self, value: str, size: int) -> str:
-        """A C expression of the wire word (uint32_t), from `value`, a value in range (a negative one converted to
-        uint32_t: its two's complement)."""
-        parts = [f"(((uint32_t){value} << {shift}) & 0x{mask << shift:x}UL)" for shift, mask in self._parts(size)]
+        """A C expression of the wire word (uint32_t; uint64_t of an 8-byte word), from `value`, a value in range (a
+        negative one converted to the unsigned type: its two's complement)."""
+        word, u = ("uint64_t", "ULL") if size > 4 else ("uint32_t", "UL")
+        parts = [f"((({word}){value} << {shift}) & 0x{mask << shift:x}{u})" for shift, mask in self._parts(size)]
         return "(" + " | ".join(parts) + ")"
 
     def lua_field(self, signed: bool) -> dict[str, object]:
@@ -189,14 +192,16 @@ def Nibbles(subcon: Any, size: int, signed: bool = False) -> Any:  # noqa: N802 
 
 
 #: The Wireshark dissector's function (arithmetic only: Wireshark's Lua may be 5.2, without bitwise operators): the
-#: value of a wire word of `size` bytes, `e.bits` bits a byte (`e` the field's `low_bits`, LowBits.lua_field), nil
-#: when a byte has a bit above them set.
-LUA = """local function low_bits(raw, size, e)
+#: value of the field's bytes (`range`, `big`: the highest group first), `e.bits` bits a byte (`e` the field's
+#: `low_bits`, LowBits.lua_field), read byte by byte (a u64's word passes a Lua number's 53 exact bits, its value of
+#: nibbles does not); nil when a byte has a bit above them set.
+LUA = """local function low_bits(range, big, e)
+  local size = range:len()
   local value = 0
   for i = 0, size - 1 do
-    local byte = math.floor(raw / 256 ^ i) % 256
+    local byte = range(big and i or size - 1 - i, 1):uint()
     if byte >= 2 ^ e.bits then return nil end
-    value = value + byte * 2 ^ (e.bits * i)
+    value = value * 2 ^ e.bits + byte
   end
   if e.signed and value >= 2 ^ (e.bits * size - 1) then value = value - 2 ^ (e.bits * size) end
   return value

@@ -324,9 +324,8 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
-                if (f.sign_magnitude or f.low_bits) and wide(f.type):
-                    how = "sign-magnitude" if f.sign_magnitude else f.low_bits.name if f.low_bits else ""
-                    raise Unsupported(f"{where}: {f.name}: {how} {f.type.name}")
+                if f.sign_magnitude and wide(f.type):
+                    raise Unsupported(f"{where}: {f.name}: sign-magnitude {f.type.name}")
             case Varint():
                 if why := varint.c_problem(f.minimum, f.maximum, f.sign):
                     raise Unsupported(f"{where}: {f.name}: {why}")

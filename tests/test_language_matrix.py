@@ -256,6 +256,7 @@ CASES: dict[str, Case] = {
             # 8-byte words: C's uint64_t, the dissector's UInt64/Int64 (a value of 32 bits, exact in Lua)
             "u": {"type": "u64", "encoding": "nibbles", "endian": "big"},
             "i": {"type": "i64", "encoding": "nibbles", "range": [-(2**31), -1], "default": -3},
+            "g": {"type": "group", "count": 2, "fields": {"n": {"type": "i16", "encoding": "nibbles"}}},
         }
     ),
     # text of 14-bit characters (Firmata's STRING_DATA): fixed-size, in a group's items, and rest

@@ -241,8 +241,23 @@ CASES: dict[str, Case] = {
             }
         },
     ),
-    "encoding: plain, seven_bit": same(
-        {"v": {"type": "i16", "encoding": "plain"}, "t": {"type": "u16", "encoding": "seven_bit"}, "w": "u8"}
+    # a few bits a byte (encodings/low_bits.py): 7 (Pololu, MIDI) or a nibble (Sony VISCA), the highest group first
+    # in big-endian order; a signed type holds the two's complement of the bits it carries (an i32 of nibbles: 16)
+    "encoding: plain, seven_bit, nibbles": same(
+        {
+            "v": {"type": "i16", "encoding": "plain"},
+            "t": {"type": "u16", "encoding": "seven_bit"},
+            "w": "u8",
+            "q": {"type": "i16", "encoding": "seven_bit", "endian": "big"},
+            "z": {"type": "u32", "encoding": "nibbles", "endian": "big"},
+            "p": {"type": "i32", "encoding": "nibbles", "range": [-32768, -1], "default": -2},  # (negative, always)
+            "d": {"type": "i8", "encoding": "nibbles"},
+            "o": {"type": "u24", "encoding": "nibbles", "endian": "big", "range": [0, 4000]},
+            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64 (a value of 32 bits, exact in Lua)
+            "u": {"type": "u64", "encoding": "nibbles", "endian": "big"},
+            "i": {"type": "i64", "encoding": "nibbles", "range": [-(2**31), -1], "default": -3},
+            "g": {"type": "group", "count": 2, "fields": {"n": {"type": "i16", "encoding": "nibbles"}}},
+        }
     ),
     # text of 14-bit characters (Firmata's STRING_DATA): fixed-size, in a group's items, and rest
     "encoding: seven_bit on a string": same(

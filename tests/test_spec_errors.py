@@ -136,7 +136,8 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "name: {type: string, size: 8, pad: 'zz'}"), "pad 'zz' must be one byte in hex"),
         (("angle: i16", "name: {type: cstring, pad: '00'}"), "`pad` goes with a string of a fixed size"),
         (("angle: i16", "m: {type: u8, enum: e, offset: 3}\nenums: {e: {values: {a: 1}}}"), "`offset` goes with"),
-        (("angle: i16", "angle: {type: i16, encoding: seven_bit}"), "seven_bit is for unsigned integers, not i16"),
+        (("angle: i16", "angle: {type: f32, encoding: seven_bit}"), "encoding seven_bit is for integers, not f32"),
+        (("angle: i16", "t: {type: i16, encoding: seven_bit, range: [0, 8192]}"), "fit i16 seven_bit (-8192..8191)"),
         (("angle: i16", "t: {type: u16, encoding: seven_bit, range: [0, 16384]}"), "fit u16 seven_bit (0..16383)"),
         (("angle: i16", "t: {type: u16, encoding: seven_bit, const: 3}"), "`const` does not go with encoding seven"),
         # a number where an integer or text is wanted said "unexpected a number", and never why 1.0 is not an integer

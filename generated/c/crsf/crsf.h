@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "8cffeb405ac70a8c7fe42b567abcc2b27e52de0a028faa878872627df62a7842"
+#define CRSF_SPEC_SHA256 "a1f92eef9d8e0ebd5c3f6ae1b6454fab480ab7c90d701d489049ca6ec4192ce0"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

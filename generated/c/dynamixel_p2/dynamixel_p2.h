@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "6c129b0a7fdf709f8ab3f7c5e39c478548c9e363b2e10b5c0573269e3a349150"
+#define DYNAMIXEL_P2_SPEC_SHA256 "f6e876c8b1c5df2f6e51db6c06782c354b28899161715c499aee3a8f7ebe787b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "35acda955e28a38f54ed2fa4852c9bc8d3ff2e269a39049e483284fc6526de71"
+#define FEETECH_SMS_SPEC_SHA256 "326843ad37ac2cebeb746584828fa706cffeb40d6b2fe2cec45f32c603437ab3"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "4723778e42c2fee3d9c5e7338a0be35b9a013ced02b1841a210477f12e9c7919"
+#define HIWONDER_RRC_SPEC_SHA256 "f84f02762325af6b140c3b6a1cb28be852e8d5b80317d85d41d25c98a0b9d78c"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

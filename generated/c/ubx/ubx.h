@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "2e7e3a13eec01d5fc8eab39e7b5971536c2224a95d6aa4ed3a9948003f48b9bd"
+#define UBX_SPEC_SHA256 "7909a0b6b34011b85e30caf4ae31fb63900a0ca1121bbe99a72f9c6c407d8cd9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -1415,10 +1415,11 @@ local function add_scalar(f, tree, range, scope)
     local top = 2 ^ (SIZES[f.type] * 8 - 1)
     if value >= top then value = -(value - top) end
     item = tree:add(f.pf, range, value)
-  elseif f.seven_bit then
-    value = seven_bit(value, SIZES[f.type])
-    if value == nil then error(string.format("%s: bit 7 of a byte is set", f.name), 0) end
-    item = tree:add(f.pf, range, value)
+  elseif f.low_bits then
+    value = low_bits(range, f.big, f.low_bits)
+    if value == nil then error(string.format("%s of a byte of %s is set", f.low_bits.flaw, f.name), 0) end
+    local wide = SIZES[f.type] == 8 and (f.low_bits.signed and Int64(value) or UInt64(value)) -- a 64-bit field's
+    item = tree:add(f.pf, range, wide or value)
   else
     item = add(tree, f.pf, range, f.big)
   end

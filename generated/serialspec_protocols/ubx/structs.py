@@ -51,7 +51,8 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
 )
 from serialspec.checksums.fletcher import fletcher_function
 from serialspec.encodings.bit_run import BitRunMember  # noqa: F401
-from serialspec.encodings.seven_bit import SevenBit, SevenBitText  # noqa: F401
+from serialspec.encodings.low_bits import Nibbles, SevenBit  # noqa: F401
+from serialspec.encodings.seven_bit import SevenBitText  # noqa: F401
 from serialspec.encodings.varint import VarintOf  # noqa: F401
 from serialspec.runtime.constructs import (  # noqa: F401
     Framed,

@@ -1,7 +1,7 @@
 """A checksum element with `encoding: seven_bit`: any algorithm's value kept to 7 bits a byte of the element and
 sent so, bit 7 of every byte clear, in the element's byte order (Dimension Engineering's Kangaroo: a CRC-14 as two
 7-bit bytes, low first). The value's low 7 × size bits are kept (a CRC's width must be those bits; a sum or XOR is
-taken modulo them); the element holds the wire word (encodings/seven_bit.py: value bit b at wire bit b + b // 7).
+taken modulo them); the element holds the wire word (encodings/low_bits.py: value bit b at wire bit b + b // 7).
 
 The wrapped checksum is still a function of the covered bytes, its result the element's wire word: every codec
 path, the frame engine and the stream parser read and write the element as plain bytes, and a frame with bit 7 set
@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from serialspec.checksums.base import Algorithm, CCode, Import, Wrapping, hex_bytes, hex_value
-from serialspec.encodings import seven_bit
+from serialspec.encodings.low_bits import SEVEN_BIT
 from serialspec.runtime.values import dataclass
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 def seven_bit_function(inner: Callable[[bytes], int], size: int) -> Callable[[bytes], int]:
     """`inner`'s value of the covered bytes, its low 7 × size bits spread 7 to a byte (the element's wire word)."""
-    return lambda covered: seven_bit.spread(inner(covered), size)
+    return lambda covered: SEVEN_BIT.spread(inner(covered), size)
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ class SevenBitWire(Wrapping):
     def c_code(self, prefix: str) -> CCode:
         """The inner algorithm's incremental C; its finish spreads the value's low bits 7 to a byte."""
         inner = self.inner.c_code(prefix)
-        finish = seven_bit.c_encode(f"({inner.finish})", self.size)
+        finish = SEVEN_BIT.c_encode(f"({inner.finish})", self.size)
         return CCode(inner.name, inner.ctype, inner.definition, inner.prototype, inner.start, finish, inner.reflects)
 
     @classmethod
@@ -66,10 +66,10 @@ class SevenBitWire(Wrapping):
         return [*self.inner.parameters(), ("sent as", f"{self.size} bytes of 7 bits, in the element's byte order")]
 
     def worked(self, covered: bytes) -> str:
-        value = self.inner.function()(covered) & seven_bit.maximum(self.size)
+        value = self.inner.function()(covered) & SEVEN_BIT.high(self.size, False)
         return (
             f"{self.title() or self.inner.name} of {hex_bytes(covered)} = {hex_value(value, 7 * self.size)}, "
-            f"7 bits a byte: {hex_value(seven_bit.spread(value, self.size), self.width)}"
+            f"7 bits a byte: {hex_value(SEVEN_BIT.spread(value, self.size), self.width)}"
         )
 
 

@@ -16,7 +16,7 @@ from typing import Any, assert_never
 from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
 from serialspec.checksums.crc import KANGAROO_CRC14
-from serialspec.encodings import bit_run, seven_bit, varint
+from serialspec.encodings import bit_run, low_bits, seven_bit, varint
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
@@ -533,8 +533,9 @@ _FIELD_LONG: dict[str, Shape] = {
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str(
         "How the integer is stored: plain two's complement, sign_magnitude (top bit the sign, the rest the size), or "
-        f"{seven_bit.DOC}; {seven_bit.TEXT_DOC}; or {varint.DOC}.",
-        choices=("plain", "sign_magnitude", seven_bit.NAME, varint.NAME),
+        f"{low_bits.SEVEN_BIT.doc}; {low_bits.NIBBLES.doc}; {low_bits.SIGNED_DOC}; {seven_bit.TEXT_DOC}; or "
+        f"{varint.DOC}.",
+        choices=("plain", "sign_magnitude", low_bits.SEVEN_BIT.name, low_bits.NIBBLES.name, varint.NAME),
         default="plain",
         example="sign_magnitude",
     ),
@@ -701,6 +702,7 @@ FIELD = OneOf(
                     "operators (`& | << >> ~`: Lua 5.2 has none) in one line.",
                 ),
                 varint.VARIANT,
+                low_bits.VARIANT,
             ),
         ),
     ),

@@ -20,7 +20,7 @@ from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
-from serialspec.encodings import bit_run, seven_bit, varint
+from serialspec.encodings import bit_run, varint
 from serialspec.lang import counts, expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -324,10 +324,8 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
-                if (f.sign_magnitude or f.seven_bit) and wide(f.type):
-                    raise Unsupported(
-                        f"{where}: {f.name}: {'sign-magnitude' if f.sign_magnitude else 'seven_bit'} {f.type.name}"
-                    )
+                if f.sign_magnitude and wide(f.type):
+                    raise Unsupported(f"{where}: {f.name}: sign-magnitude {f.type.name}")
             case Varint():
                 if why := varint.c_problem(f.minimum, f.maximum, f.sign):
                     raise Unsupported(f"{where}: {f.name}: {why}")
@@ -624,7 +622,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 # a hidden value keeps its wire bits, a signed one its value (as Python compares it); a constant
                 # only its bits: no helper is written that nothing calls
                 needs_value = f.const is None and (not f.hidden or f.type.signed) and not f.sign_magnitude
-                needs_value = needs_value and not f.seven_bit
+                needs_value = needs_value and f.low_bits is None
                 value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value and place is None else ""
                 if place is not None:  # a member of a bit run: its bits of the run (encodings/bit_run.py)
                     w = bit_run.c_width(place.bits)
@@ -645,11 +643,11 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     if place.last:
                         out.append(f"{pad}o += {place.size}u;")
                     continue
-                if f.seven_bit:  # 7 bits a byte, bit 7 of each clear
+                if (encoding := f.low_bits) is not None:  # a few bits a byte, the bits above them clear
                     raw = get_raw(ctx, f.type, f.endian, "c + o")
-                    marks = seven_bit.marks(size)
+                    marks = encoding.marks(size)
                     out.append(f"{pad}if (({raw} & 0x{marks:x}UL) != 0u) {{ return {ctx.P}_E_CONTENT; }}")
-                    value = f"({ctype(f.type)}){seven_bit.c_decode(raw, size)}"
+                    value = f"({ctype(f.type)}){encoding.c_decode(raw, size, f.type.signed)}"
                 if f.sign_magnitude:  # the top bit is the sign, the rest the magnitude
                     top = 1 << (8 * size - 1)
                     raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
@@ -1331,8 +1329,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     if f.sign_magnitude:
                         top = 1 << (8 * size - 1)
                         value = f"({tgt} < 0 ? ((uint32_t)(-(int32_t){tgt}) | 0x{top:x}UL) : (uint32_t){tgt})"
-                    if f.seven_bit:
-                        value = seven_bit.c_encode(tgt, size)
+                    if f.low_bits is not None:
+                        value = f.low_bits.c_encode(tgt, size)
                 place = f.bit_place
                 if place is not None:  # a member of a bit run: its bits into the run (encodings/bit_run.py)
                     if place.first:

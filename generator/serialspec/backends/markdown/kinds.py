@@ -81,7 +81,7 @@ class ScalarKind(Kind[Scalar]):
 
     def type_name(self, f: Scalar) -> str:
         name = f.type.name + (" (sign-magnitude)" if f.sign_magnitude else "")
-        name += seven_bit.TYPE_NOTE if f.seven_bit else ""
+        name += f.low_bits.type_note if f.low_bits is not None else ""
         if f.enum:
             name += f" enum [{f.enum.class_name}](#enum-{anchor(f.enum.name)})"
         if f.flags:

@@ -59,7 +59,7 @@ from serialspec.backends.python.optimize import (
     read_fields_once,
 )
 from serialspec.backends.python.render import one_line
-from serialspec.encodings import bit_run, seven_bit
+from serialspec.encodings import bit_run
 from serialspec.lang import counts, expression
 from serialspec.lang.model import (
     Array,
@@ -693,7 +693,7 @@ class PackageCode:
             return name
         if f.odd_width:  # read as 3 bytes
             order = "big" if f.endian == ">" else "little"
-            body.append(Code(f"{name} = int.from_bytes({name}, {order!r}, signed={f.type.signed})"))
+            body.append(Code(f"{name} = int.from_bytes({name}, {order!r}, signed={f.wire_signed})"))
         if f.const is not None:
             error = f"DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')"
             body.append(Expect(name, f"{f.const}", error))
@@ -703,11 +703,13 @@ class PackageCode:
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
             body.append(If(f"{name} & {top:#x}", (Code(f"{name} = -({name} & {top - 1:#x})"),)))
-        if f.seven_bit:
-            marks = seven_bit.marks(f.type.size)
-            error = f"DecodeError({where} + f': bit 7 of a byte of {f.name} is set ({{{name}:#06x}})')"
+        if (encoding := f.low_bits) is not None:  # a few bits a byte (encodings/low_bits.py)
+            size = f.type.size
+            marks = encoding.marks(size)
+            shown = f"{{{name}:#0{2 + 2 * size}x}}"
+            error = f"DecodeError({where} + f': {encoding.flaw} of a byte of {f.name} is set ({shown})')"
             body.append(If(f"{name} & {marks:#x}", (Raise(error),)))
-            body.append(Code(f"{name} = {seven_bit.python_decode(name, f.type.size)}"))
+            body.append(Code(f"{name} = {encoding.python_decode(name, size, f.type.signed)}"))
         if f.bits:
             used = 0
             parts = []
@@ -1112,8 +1114,8 @@ class PackageCode:
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
             return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
-        if f.seven_bit:
-            return seven_bit.python_encode(expr, f.type.size)
+        if f.low_bits is not None:
+            return f.low_bits.python_encode(expr, f.type.size)
         return Simple(expr)
 
     @staticmethod
@@ -1146,7 +1148,7 @@ class PackageCode:
                 case Scalar() if f.odd_width:
                     order = "big" if f.endian == ">" else "little"
                     wire = self.wire_value(f, obj, siblings, body, where)
-                    args.append(f"({wire}).to_bytes(3, {order!r}, signed={f.type.signed})")
+                    args.append(f"({wire}).to_bytes(3, {order!r}, signed={f.wire_signed})")
                 case Scalar():
                     args.append(self.wire_value(f, obj, siblings, body, where))
                 case Packed():

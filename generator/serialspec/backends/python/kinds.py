@@ -100,13 +100,15 @@ def list_item_type(f: List) -> str:
 _INT = {1: "Int8", 2: "Int16", 3: "Int24", 4: "Int32", 8: "Int64"}
 
 
-def primitive(scalar: ScalarType, endian: str) -> str:
+def primitive(scalar: ScalarType, endian: str, signed: bool | None = None) -> str:
+    """construct's integer of the type (`signed`: read signed or not, whatever the type)."""
     suffix = "b" if endian == ">" else "l"
+    signed = scalar.signed if signed is None else signed
     if scalar.is_float:
         return f"Float{scalar.size * 8}{suffix}"
     if scalar.size == 1:
-        return "Int8sb" if scalar.signed else "Int8ub"
-    return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
+        return "Int8sb" if signed else "Int8ub"
+    return f"{_INT[scalar.size]}{'s' if signed else 'u'}{suffix}"
 
 
 def list_expr(f: List) -> str:
@@ -169,7 +171,7 @@ class ScalarKind(Kind[Scalar]):
     model = Scalar
 
     def construct(self, f: Scalar, parent: str) -> str:
-        base = primitive(f.type, f.endian) if f.bit_place is None else bit_member(f)
+        base = primitive(f.type, f.endian, f.wire_signed) if f.bit_place is None else bit_member(f)
         if f.const is not None:
             return f"Const({f.const}, {base})"
         if f.value is not None:
@@ -187,8 +189,9 @@ class ScalarKind(Kind[Scalar]):
             return bits_expr(f)
         if f.sign_magnitude:
             return f"SignMagnitude({base}, {f.type.size * 8})"
-        if f.seven_bit:
-            return f"SevenBit({base}, {f.type.size})"
+        if f.low_bits is not None:
+            signed = ", signed=True" if f.type.signed else ""
+            return f"{f.low_bits.construct_name}({base}, {f.type.size}{signed})"
         return base
 
     def fixed(self, f: Scalar) -> bool:
@@ -197,6 +200,8 @@ class ScalarKind(Kind[Scalar]):
     def struct_chars(self, f: Scalar) -> str:
         if f.bit_place is not None:  # the run's bytes, read at its first field (encodings/bit_run.py)
             return f"{f.bit_place.size}s" if f.bit_place.first else ""
+        if f.type.signed and not f.wire_signed and not f.odd_width:  # an unsigned word, signed by its own bits
+            return f.type.struct_char.upper()
         return f.type.struct_char
 
     def annotation(self, f: Scalar) -> str:

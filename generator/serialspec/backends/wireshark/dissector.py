@@ -15,7 +15,7 @@ from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import layout_codes, runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.backends.common.text import collapse
-from serialspec.encodings import bit_run, seven_bit
+from serialspec.encodings import bit_run, low_bits, seven_bit
 from serialspec.lang import counts
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
@@ -89,9 +89,9 @@ def emit_dissector(protocol: Protocol) -> str:
         layouts=lua(shared, 0),
         data=lua(data, 0),
         checksums=_checksum_functions(protocol),
-        # the `encoding: seven_bit` function, where a field uses it
-        seven_bit_lua=seven_bit.LUA
-        if any(isinstance(f, Scalar) and f.seven_bit for m in protocol.messages() for f in _all_fields(m.fields))
+        # the `encoding: seven_bit` and `nibbles` function, where a field uses one
+        low_bits_lua=low_bits.LUA
+        if any(isinstance(f, Scalar) and f.low_bits for m in protocol.messages() for f in _all_fields(m.fields))
         else "",
         # and its text of 14-bit characters, where a string uses it
         seven_bit_text_lua=seven_bit.LUA_TEXT
@@ -373,8 +373,8 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
             common["offset"] = item.offset
             common.update(_scalar_extras(item.flags, item.bits, item.enum), hidden=item.hidden)
             common["sign_magnitude"] = item.sign_magnitude
-            if item.seven_bit:  # (absent: nil, false to the engine)
-                common["seven_bit"] = True
+            if item.low_bits is not None:  # a few bits a byte (absent: nil, false to the engine)
+                common["low_bits"] = item.low_bits.lua_field(item.type.signed)
             if (place := item.bit_place) is not None:  # a member of a bit run (encodings/bit_run.py)
                 common.update(bit_run.lua_field(place.bits, place.shift, place.size, item.type.signed))
         case Varint():  # as many bytes as the value needs (encodings/varint.py)

@@ -65,7 +65,7 @@ def leading_constant(message: Message) -> tuple[tuple[int, str, int, int], int] 
     first = message.fields[0]
     if not isinstance(first, Scalar) or first.const is None or first.type.is_float or first.type.size == 3:
         return None
-    if first.seven_bit or first.sign_magnitude:
+    if first.low_bits is not None or first.sign_magnitude:
         return None  # its wire bytes are not the value's
     place = first.bit_place
     if place is not None:

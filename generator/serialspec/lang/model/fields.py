@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from typing import Literal
 
+from serialspec.encodings.low_bits import LowBits
 from serialspec.lang.expression import Expr, show
 from serialspec.lang.frozen import frozen
 
@@ -183,7 +184,7 @@ class Scalar(Common):
     value: Expr | None = None
     offset: float | None = None  # engineering value = wire value × scale + offset
     value_at: tuple[int, int] = (1, 1)  # line and column of `value:` in the spec, for a target's refusal of it
-    seven_bit: bool = False  # `encoding: seven_bit`: 7 bits a byte (serialspec/encodings/seven_bit.py)
+    low_bits: LowBits | None = None  # `encoding: seven_bit` or `nibbles`: a few bits a byte (encodings/low_bits.py)
     bit_place: BitPlace | None = None  # a member of a bit run (serialspec/encodings/bit_run.py)
 
     @property
@@ -195,6 +196,12 @@ class Scalar(Common):
     def hidden(self) -> bool:
         """Not a member of the message: constant or derived."""
         return self.const is not None or bool(self.derived) or self.value is not None
+
+    @property
+    def wire_signed(self) -> bool:
+        """Its wire word read as a signed integer: a signed type's, but a few bits a byte (low_bits), whose word is
+        unsigned and its value signed by its own bits."""
+        return self.type.signed and self.low_bits is None
 
 
 @frozen

@@ -14,7 +14,7 @@ import sys
 from dataclasses import field
 from typing import Any, Literal
 
-from serialspec.encodings import seven_bit
+from serialspec.encodings.low_bits import LowBits
 from serialspec.lang import grammar
 from serialspec.lang.errors import SpecError, listed, type_hint
 from serialspec.lang.frozen import mutable
@@ -364,13 +364,16 @@ class Pass:
         given: Any,
         path: Path,
         sign_bit: int | None = None,
-        seven_bits: bool = False,
+        low_bits: LowBits | None = None,
     ) -> tuple[float, float]:
         if sign_magnitude:
             limit = (1 << (sign_bit if sign_bit is not None else scalar.size * 8 - 1)) - 1
             low, high = float(-limit), float(limit)
-        elif seven_bits:
-            low, high = 0.0, float(seven_bit.maximum(scalar.size))
+        elif low_bits is not None:
+            low, high = (
+                float(low_bits.low(scalar.size, scalar.signed)),
+                float(low_bits.high(scalar.size, scalar.signed)),
+            )
         else:
             low, high = scalar.minimum, scalar.maximum
         if given is None:
@@ -382,6 +385,6 @@ class Pass:
         if fractions and not scalar.is_float:  # a bound between two values: C and Python would round it apart
             self.error(path, f"range bound {fractions[0]} is no whole number: a {scalar.name} holds whole numbers")
         if given_low < low or given_high > high:
-            what = f"{scalar.name} {seven_bit.NAME}" if seven_bits else scalar.name
+            what = f"{scalar.name} {low_bits.name}" if low_bits is not None else scalar.name
             self.error(path, f"range [{given_low}, {given_high}] does not fit {what} ({low:g}..{high:g})")
         return given_low, given_high

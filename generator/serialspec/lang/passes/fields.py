@@ -6,7 +6,7 @@ import re
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec.encodings import bit_run, seven_bit, varint
+from serialspec.encodings import bit_run, low_bits, seven_bit, varint
 from serialspec.lang import counts, expression, grammar
 from serialspec.lang.errors import listed, type_hint
 from serialspec.lang.loader import Path
@@ -87,7 +87,7 @@ class FieldResolver(Pass):
         is an error at its first field (unless a field is missing, its mistake said: the runs are not known)."""
 
         def bits(f: Field) -> int | None:
-            plain = isinstance(f, Scalar) and not (f.type.is_float or f.bits or f.sign_magnitude or f.seven_bit)
+            plain = isinstance(f, Scalar) and not (f.type.is_float or f.bits or f.sign_magnitude or f.low_bits)
             if not isinstance(f, Scalar) or not plain:
                 return None
             return bit_run.width(f.type.name) or f.type.size * 8
@@ -496,13 +496,16 @@ class FieldResolver(Pass):
             raise self.fail(
                 (*path, odd[0]), f"`{odd[0]}` does not go with a bit field ({scalar.name}: packed MSB first)"
             )
-        seven_bits = spec.get("encoding") == seven_bit.NAME
-        if seven_bits and (why := seven_bit.problem(scalar.name, scalar.signed, scalar.is_float)):
+        encoding = low_bits.ENCODINGS.get(str(spec.get("encoding")))  # a few bits a byte (encodings/low_bits.py)
+        if encoding is not None and (why := encoding.problem(scalar.name, scalar.is_float)):
             self.error((*path, "encoding"), why)
-            seven_bits = False
-        if seven_bits and (mixed := [key for key in ("const", "bits", "flags", "value") if key in spec]):
-            self.error((*path, mixed[0]), f"`{mixed[0]}` does not go with encoding seven_bit (a number 7 bits a byte)")
-        low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"), seven_bits=seven_bits)
+            encoding = None
+        if encoding is not None and (mixed := [key for key in ("const", "bits", "flags", "value") if key in spec]):
+            self.error(
+                (*path, mixed[0]),
+                f"`{mixed[0]}` does not go with encoding {encoding.name} (a number {encoding.bits} bits a byte)",
+            )
+        low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"), low_bits=encoding)
         value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
         if value_enum is not None and spec.get("range") is None:
             low, high = enum_span(value_enum, low, high)
@@ -572,7 +575,7 @@ class FieldResolver(Pass):
             value=self.derived_value(spec, scalar, path),
             offset=spec.get("offset"),
             value_at=self.doc.where((*path, "value")),
-            seven_bit=seven_bits,
+            low_bits=encoding,
         )
 
     def varint(self, common: dict[str, Any], spec: dict[str, Any], path: Path) -> Field:
@@ -632,8 +635,8 @@ class FieldResolver(Pass):
                     return  # derived by its own expression, which decoding checks
                 if not isinstance(field, Scalar) or field.type.is_float or field.hidden:
                     raise self.fail(path, f"{name!r} must be an earlier integer field that nothing else derives")
-                if field.seven_bit:
-                    raise self.fail(path, f"{name!r} holds a count or size: plain, not encoding seven_bit")
+                if field.low_bits is not None:
+                    raise self.fail(path, f"{name!r} holds a count or size: plain, not encoding {field.low_bits.name}")
                 siblings[index] = replace(field, derived=derivation)
                 return
         raise self.fail(path, f"unknown field {name!r}: a count or size must be an earlier field of the same content")

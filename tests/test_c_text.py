@@ -25,7 +25,19 @@ from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.text import Sentence, TextField, TextFraming, TextSentence, encode_field
 from serialspec.runtime.values import replace
-from test_c_backend import BUILDS, C_CHECK, CLANG, DEFAULT_BUILD, FLAGS, GCC, GXX, Driver, compiler, m32_builds
+from test_c_backend import (
+    BUILDS,
+    C_CHECK,
+    CLANG,
+    DEFAULT_BUILD,
+    FLAGS,
+    GCC,
+    GXX,
+    Driver,
+    compiler,
+    m32_builds,
+    warning_flags,
+)
 from test_language_matrix import TEXT_CASE
 from test_text_frames import sentence_values
 
@@ -354,7 +366,9 @@ def directions(b: Built) -> list[str]:
 def test_compiles_without_a_warning(name: str, level: str, build: str, tmp_path: Path) -> None:
     folder = built(name).folder / "c" / name
     for source in (folder / f"{name}.c", folder / f"{name}_json.c"):
-        done = subprocess.run([*compiler(build), *FLAGS, level, "-c", str(source), "-o", str(tmp_path / "o.o")])
+        done = subprocess.run(
+            [*compiler(build), *FLAGS, level, *warning_flags(build), "-c", str(source), "-o", str(tmp_path / "o.o")]
+        )
         assert done.returncode == 0
 
 

@@ -16,6 +16,7 @@ import contextlib
 import json
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -187,12 +188,13 @@ def expression_spec(value: str, b_type: str = "i8", check_type: str = "i64") -> 
     return yaml.safe_dump(spec, sort_keys=False)
 
 
-def frame_of(a: int, b: int, check: int, b_type: str) -> bytes:
-    """The frame of `set` with these wire values, whatever the check (its 8 bytes as two's complement)."""
+def frame_of(a: int, b: int, check: int, b_type: str, code: int = 1) -> bytes:
+    """The frame of command `code` (`set` or EXPRESSIONS' `set<code>`) with these wire values, whatever the check
+    (its 8 bytes as two's complement)."""
     content = a.to_bytes(2, "little", signed=True) + b.to_bytes(1, "little", signed=b_type == "i8")
     content += (check % (1 << 64)).to_bytes(8, "little")
-    covered = bytes([1, len(content)]) + content  # the checksum covers code to content
-    return bytes([0xAA, 0x55, 1, len(content)]) + content + bytes([sum(covered) & 0xFF])
+    covered = bytes([code, len(content)]) + content  # the checksum covers code to content
+    return bytes([0xAA, 0x55, code, len(content)]) + content + bytes([sum(covered) & 0xFF])
 
 
 EXPRESSIONS = [
@@ -215,38 +217,67 @@ EXPRESSIONS = [
 ]
 
 
-@pytest.mark.skipif(GCC is None, reason="no gcc")
-@pytest.mark.parametrize(("value", "b_type", "check_type"), EXPRESSIONS)
-def test_c_computes_every_expression_as_python_does(value: str, b_type: str, check_type: str, tmp_path: Path) -> None:
-    """Random a (i16) and b: the frame Python encodes (check computed) decodes in C to the same fields and encodes
-    back byte for byte; a frame with any check value (or the expression's value as 8 bytes) is accepted by C exactly
-    when Python accepts it."""
-    protocol = resolve(load_text(expression_spec(value, b_type, check_type), "expr.yaml"))
-    source = tmp_path / "c"
+def expressions_spec() -> str:
+    """One spec holding every expression of EXPRESSIONS, command `set<i>` (code i) for the i-th (from 1): one C
+    build for all of them."""
+    spec = yaml.safe_load(expression_spec("a + b"))
+    spec["commands"] = {
+        f"set{code}": {
+            "code": code,
+            "request": {"fields": {"a": "i16", "b": b_type, "check": {"type": check_type, "value": value}}},
+        }
+        for code, (value, b_type, check_type) in enumerate(EXPRESSIONS, 1)
+    }
+    return yaml.safe_dump(spec, sort_keys=False)
+
+
+@pytest.fixture(scope="module")
+def expressions_c(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Driver, Any]]:
+    """EXPRESSIONS' spec in C (its files compiled warning-free under the shipped specs' flags) with the driver, and
+    in Python, built once for this module (and process)."""
+    if GCC is None:
+        pytest.skip("no gcc")
+    folder = tmp_path_factory.mktemp("expressions")
+    protocol = resolve(load_text(expressions_spec(), "expr.yaml"))
+    source = folder / "c"
     source.mkdir()
     for path, text in c_files(protocol).items():
         (source / Path(path).name).write_text(text, encoding="utf-8")
     for name in (f"{protocol.name}.c", f"{protocol.name}_json.c"):  # the helpers compile warning-free too
-        strict = [GCC, *FLAGS, "-O2", "-c", str(source / name), "-o", str(tmp_path / "x.o")]
+        strict = [GCC, *FLAGS, "-O2", "-c", str(source / name), "-o", str(folder / "x.o")]
         compiled = subprocess.run(strict, capture_output=True, text=True)
         assert compiled.returncode == 0, compiled.stderr
-    run = Driver(protocol.name, source, tmp_path)
-    b_range = (-128, 127) if b_type == "i8" else (0, 255)
+    run = Driver(protocol.name, source, folder)
     try:
         with imported(protocol.name, emit_package(protocol)) as package:
-            agree_all(run, package, expression.parse(value), b_range, b_type)
+            yield run, package
     finally:
         run.close()
 
 
-def agree_all(run: Driver, package: Any, expr: expression.Expr, b_range: tuple[int, int], b_type: str) -> None:
-    """The Python package and the C driver agree on random fields and frames."""
+@pytest.mark.parametrize(("code", "value", "b_type", "check_type"), [(i, *e) for i, e in enumerate(EXPRESSIONS, 1)])
+def test_c_computes_every_expression_as_python_does(
+    code: int, value: str, b_type: str, check_type: str, expressions_c: tuple[Driver, Any]
+) -> None:
+    """Random a (i16) and b: the frame Python encodes (check computed) decodes in C to the same fields and encodes
+    back byte for byte; a frame with any check value (or the expression's value as 8 bytes) is accepted by C exactly
+    when Python accepts it."""
+    run, package = expressions_c
+    b_range = (-128, 127) if b_type == "i8" else (0, 255)
+    message = getattr(package, f"Set{code}Request")
+    agree_all(run, package, expression.parse(value), b_range, b_type, message, code)
+
+
+def agree_all(
+    run: Driver, package: Any, expr: expression.Expr, b_range: tuple[int, int], b_type: str, message: Any, code: int
+) -> None:
+    """The Python package and the C driver agree on random fields and frames of one command."""
 
     @settings(max_examples=examples(80), deadline=None, suppress_health_check=list(HealthCheck))
     @given(st.integers(-32768, 32767), st.integers(*b_range), st.integers(-(1 << 63), (1 << 64) - 1), st.integers(0, 2))
     def agree(a: int, b: int, check: int, how: int) -> None:
         try:
-            frame: bytes | None = package.encode(package.SetRequest(a=a, b=b))
+            frame: bytes | None = package.encode(message(a=a, b=b))
         except EncodeError:
             frame = None
         if how == 0 and frame is not None:
@@ -258,7 +289,7 @@ def agree_all(run: Driver, package: Any, expr: expression.Expr, b_range: tuple[i
         if how == 1:  # the expression's own value, in the check's 8 bytes whatever its sign
             with contextlib.suppress(ZeroDivisionError, ValueError):
                 check = expression.evaluate(expr, {"a": a, "b": b})
-        frame = frame_of(a, b, check, b_type)
+        frame = frame_of(a, b, check, b_type, code)
         try:
             package.decode(frame, "request")
             python = "ok"

@@ -667,6 +667,31 @@ def message_class(g: Generated, message: Message) -> Any:
 
 # Known to fail; each is a bug to fix, strict so that the fix is noticed (and the mark removed).
 KNOWN: dict[str, str] = {}
+# a one-byte length that says a larger size in a wider one after it (`extended:`, MQTT-SN's shape: the length counts
+# itself, 0x01 then a big-endian u16): 251 + 2 bytes and a few more, so random messages take either form
+CASES["frame: extended length (a marker, then a u16), counting itself"] = same(
+    {"pad": {"type": "bytes", "size": 251}, "data": {"type": "bytes", "size": "rest"}}
+)
+CASES["frame: extended length (a marker, then a u16), counting itself"] = Case(
+    **{
+        **CASES["frame: extended length (a marker, then a u16), counting itself"].__dict__,
+        "framing": {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "length": {
+                    "role": "length",
+                    "type": "u8",
+                    "extended": {"when": 1, "type": "u16"},
+                    "counts": ["length", "content"],
+                    "range": [2, 700],
+                },
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["length", "content"]},
+            }
+        },
+    }
+)
 CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
     CASES["frame: transparency"].request,
     {"v": "u16"},

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "8cffeb405ac70a8c7fe42b567abcc2b27e52de0a028faa878872627df62a7842"
+#define CRSF_SPEC_SHA256 "890e79777fac1924f50b4b8d135620b9189a6c9d1a2d65ab77d7549556e69cd7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "6c129b0a7fdf709f8ab3f7c5e39c478548c9e363b2e10b5c0573269e3a349150"
+#define DYNAMIXEL_P2_SPEC_SHA256 "3bf6b21b4a91b1e6e83cd2ce3384bf4ec0fae5407c5463f70895417797a6d026"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

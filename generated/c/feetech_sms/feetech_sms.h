@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "35acda955e28a38f54ed2fa4852c9bc8d3ff2e269a39049e483284fc6526de71"
+#define FEETECH_SMS_SPEC_SHA256 "3743bacb63bac1d72847e12c4155d15e89821228c203564563b562c96fcbc990"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

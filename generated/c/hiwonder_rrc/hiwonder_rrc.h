@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "4723778e42c2fee3d9c5e7338a0be35b9a013ced02b1841a210477f12e9c7919"
+#define HIWONDER_RRC_SPEC_SHA256 "14a0d4dc293651a2ff530bc04765a2eed0555671a48d6c6d85233d9db107047e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "6211d860a0b1d658f1d853bc7c71fb21e0fab677993989c22cc968d20450cabd"
+#define MAVLINK_COMMON_SPEC_SHA256 "e830bdfd3ffa4ae329b6ca6459cbfa4fcbe1adfb55d7ca8964789870a34f2885"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

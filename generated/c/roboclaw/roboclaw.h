@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "ab2c76a17640fce8c212d563f95ce04fda3ed3afb4c5c9a62c90e1ddfe719091"
+#define ROBOCLAW_SPEC_SHA256 "b35a6b64d732448fc3ad26ec6ce93e035ab90520dd95b7e08da1f2bedc366f93"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

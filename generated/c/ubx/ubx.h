@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "2e7e3a13eec01d5fc8eab39e7b5971536c2224a95d6aa4ed3a9948003f48b9bd"
+#define UBX_SPEC_SHA256 "ff84844c96ac2ddc273a2084185b95ed25754b277e6c146619a7b68190342f4a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "a2aa8879f99a71c3c87530231093d5a4190ef50760de2a1f6e39318d3648e6a6"
+#define VESC_SPEC_SHA256 "b59e8d646f91804774290ece3cddebbf3aa1c72968d122fd08a25c24ace367c1"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -294,18 +294,22 @@ class FramingPass(FieldResolver):
     ) -> ScalarType | None:
         """The wider type of a length's long form (`extended:`), None without one (or on a mistake, said here)."""
         given = item.get("extended")
-        if not isinstance(given, dict) or role != "length" or scalar is None:
+        if "extended" not in item or role != "length" or scalar is None:
             return None
         if scalar.name != "u8":
             self.error(
                 (*path, "type"), f"an extended length is one byte unless it says more: type u8, not {scalar.name}"
             )
             return None
-        return SCALARS[str(given.get("type", "u16"))]
+        wide = given.get("type") if isinstance(given, dict) else None  # (a malformed one: the grammar said so)
+        return SCALARS[wide] if wide in SCALARS else SCALARS["u16"]
 
-    def extended(self, given: dict[str, Any], wide: ScalarType, low: int, high: int, path: Path) -> ExtendedLength:
-        """The long form: its marker, size and the values each form holds (`adds` is the layout's, see layout())."""
-        marker = int(given["when"])
+    def extended(self, given: Any, wide: ScalarType, low: int, high: int, path: Path) -> ExtendedLength | None:
+        """The long form: its marker, size and the values each form holds (`adds` is the layout's, see layout());
+        None for a malformed one (the grammar said what is wrong)."""
+        if not isinstance(given, dict) or not isinstance(given.get("when"), int):
+            return None
+        marker = given["when"]
         short_low, short_high = low, min(high, 255)
         if short_low <= marker <= short_high:
             if marker == short_high:

@@ -7,7 +7,9 @@ u16) runs it through every output with random messages."""
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import io
 import shutil
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
@@ -22,6 +24,7 @@ from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.errors import DecodeError, EncodeError
 
 SPEC = Path(__file__).parent / "specs" / "xsens_mt.yaml"
+MQTT_SN = Path(__file__).parent / "specs" / "mqtt_sn.yaml"
 
 
 @pytest.fixture(scope="module")
@@ -145,12 +148,53 @@ def test_a_wrong_extended_length_is_one_line(elements: str, said: str, tmp_path:
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
-def test_the_c_decodes_encodes_and_parses_both_forms(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("spec", "printed"), [(SPEC, "xsens_mt: 5"), (MQTT_SN, "mqtt_sn: 3")], ids=["xsens", "mqtt-sn"]
+)
+def test_the_c_decodes_encodes_and_parses_both_forms(spec: Path, printed: str, tmp_path: Path) -> None:
     """The C's vectors (every example decoded, encoded back byte for byte and found by the parser fed a byte at a
-    time): the 255-byte MTData2 is the one-byte form refused by its range (255 is the marker) and sent long."""
+    time): the 255-byte MTData2 is the one-byte form refused by its range (255 is the marker) and sent long; the
+    258-byte MQTT-SN PUBLISH is too long for the one-byte form's field."""
     from test_c_backend import check_vectors
 
-    assert check_vectors(SPEC, "xsens_mt", tmp_path).strip() == "xsens_mt: 5 vectors, 0 refused frames, 0 failed"
+    assert check_vectors(spec, spec.stem, tmp_path).strip() == f"{printed} vectors, 0 refused frames, 0 failed"
+
+
+@pytest.fixture(scope="module")
+def mqtt_sn() -> Iterator[ModuleType]:
+    from serialspec.backends.python import files as python_files
+    from serialspec.backends.python.memory import imported
+
+    protocol = load_protocol(str(MQTT_SN))
+    modules = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+    with imported(protocol.name, modules, "the MQTT-SN test") as package:
+        yield package
+
+
+@settings(max_examples=examples(25), deadline=None)
+@given(
+    size=st.one_of(st.integers(0, 700), st.sampled_from([247, 248, 249, 250])),
+    topic_id=st.integers(0, 0xFFFF),
+    msg_id=st.integers(0, 0xFFFF),
+    byte=st.integers(0, 255),
+)
+def test_mqtt_sn_publish_as_the_mqttsn_package_writes_and_reads_it(
+    mqtt_sn: ModuleType, size: int, topic_id: int, msg_id: int, byte: int
+) -> None:
+    """PyPI's mqttsn (its Publishes, the length rule of MQTT-SN 1.2 5.2.1 in MessageHeaders) writes our frames byte
+    for byte, the one-byte length up to 255 bytes (248 data bytes), 01 and a u16 counting all 3 of its bytes from 256
+    on; we read its frames and it reads ours."""
+    publishes = pytest.importorskip("mqttsn.lib.publishes")
+    message = mqtt_sn.PublishRequest(flags=0x04, topic_id=topic_id, msg_id=msg_id, data=bytes([byte]) * size)
+    peer = publishes.Publishes()
+    peer.topic_id, peer.msg_id, peer.data = topic_id, msg_id, message.data
+    with contextlib.redirect_stdout(io.StringIO()):  # (its pack prints the buffer)
+        theirs = peer.pack()
+    ours = mqtt_sn.encode(message)
+    assert ours == theirs and (ours[0] == 0x01) == (size > 248)
+    assert mqtt_sn.decode(theirs, "request") == message
+    read = publishes.Publishes(ours)
+    assert (read.topic_id, read.msg_id, read.data) == (topic_id, msg_id, message.data)
 
 
 @pytest.mark.skipif(shutil.which("tshark") is None, reason="tshark is not installed")

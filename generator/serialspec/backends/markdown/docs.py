@@ -561,6 +561,7 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             long_form = (
                 f"{x.short[0]}..{x.short[1]} in one byte; larger, the long form: {x.marker:#04x} then the value as a "
                 f"big-endian {wide} ({x.long[0]}..{x.long[1]}), everything after it {x.size} bytes later"
+                + (f", its count + {x.adds} (its own bytes)" if x.adds != e.adds else "")
             )
             description = ". ".join(p for p in (long_form, description) if p)
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")

@@ -2067,7 +2067,7 @@ static int crsf__frame(crsf_direction_t dir, uint32_t code, const uint32_t *valu
             return r;
         }
         *len = 0u;
-        if (r != CRSF_E_LENGTH) {
+        if (r != CRSF_E_LENGTH && r != CRSF_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

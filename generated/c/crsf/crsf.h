@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "a1f92eef9d8e0ebd5c3f6ae1b6454fab480ab7c90d701d489049ca6ec4192ce0"
+#define CRSF_SPEC_SHA256 "4436068378b5652f90201de3074e0f85a3b63e39dc6b05703c786299f3b8a882"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -1739,7 +1739,7 @@ static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, cons
             return r;
         }
         *len = 0u;
-        if (r != DYNAMIXEL_P2_E_LENGTH) {
+        if (r != DYNAMIXEL_P2_E_LENGTH && r != DYNAMIXEL_P2_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

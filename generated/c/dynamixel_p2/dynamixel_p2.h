@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "f6e876c8b1c5df2f6e51db6c06782c354b28899161715c499aee3a8f7ebe787b"
+#define DYNAMIXEL_P2_SPEC_SHA256 "fadfa7e5b0c30671bb478e6613bf7dd539d9a446eb5cde00ad0f9ed8645b64e2"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

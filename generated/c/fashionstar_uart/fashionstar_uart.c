@@ -3831,7 +3831,7 @@ static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t co
             return r;
         }
         *len = 0u;
-        if (r != FASHIONSTAR_UART_E_LENGTH) {
+        if (r != FASHIONSTAR_UART_E_LENGTH && r != FASHIONSTAR_UART_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -1397,7 +1397,7 @@ static int feetech_sms__frame(feetech_sms_direction_t dir, uint32_t code, const 
             return r;
         }
         *len = 0u;
-        if (r != FEETECH_SMS_E_LENGTH) {
+        if (r != FEETECH_SMS_E_LENGTH && r != FEETECH_SMS_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "326843ad37ac2cebeb746584828fa706cffeb40d6b2fe2cec45f32c603437ab3"
+#define FEETECH_SMS_SPEC_SHA256 "a4b8299cbf3040b6fa1fe83210c7985389d3ffd00a08c172b6b67529805e4aec"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

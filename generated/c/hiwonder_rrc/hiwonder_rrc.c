@@ -3616,7 +3616,7 @@ static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, cons
             return r;
         }
         *len = 0u;
-        if (r != HIWONDER_RRC_E_LENGTH) {
+        if (r != HIWONDER_RRC_E_LENGTH && r != HIWONDER_RRC_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "f84f02762325af6b140c3b6a1cb28be852e8d5b80317d85d41d25c98a0b9d78c"
+#define HIWONDER_RRC_SPEC_SHA256 "7e6691d95e9299f2ba5468c9891670031afa8bc653c9b90dbec225ee360178ee"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

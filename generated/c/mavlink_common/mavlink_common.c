@@ -1282,9 +1282,12 @@ static int mavlink_common__unwrap_at(mavlink_common_direction_t dir, uint8_t k, 
 }
 
 
-/* 1 when frame f[0..n) has the flag bits of the direction's layout k (the optional elements it sends). */
+/* 1 when frame f[0..n) has the flag bits of the direction's layout k (the optional elements it sends; an extended
+ * length's marker byte, or not). */
 static int mavlink_common__admits(mavlink_common_direction_t dir, uint8_t k, const uint8_t *f, size_t n)
 {
+    (void)f;
+    (void)n;
     switch (dir) {
     case MAVLINK_COMMON_REQUEST:
         switch (k) {
@@ -1311,6 +1314,7 @@ static int mavlink_common__admits(mavlink_common_direction_t dir, uint8_t k, con
     }
     return 1;
 }
+
 
 /* Where the optional elements of layout k lie in frame f[0..n) (NULL: not sent), by their order in the direction. */
 static void mavlink_common__extras(mavlink_common_direction_t dir, uint8_t k, const uint8_t *f, size_t n, const uint8_t **at)
@@ -2445,7 +2449,7 @@ static int mavlink_common__frame(mavlink_common_direction_t dir, uint32_t code, 
             return r;
         }
         *len = 0u;
-        if (r != MAVLINK_COMMON_E_LENGTH) {
+        if (r != MAVLINK_COMMON_E_LENGTH && r != MAVLINK_COMMON_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "290aef1766c6b003b0d80c212d8e4b5470ce92609b77cc08aeb494dfc9b465da"
+#define MAVLINK_COMMON_SPEC_SHA256 "89d853340fa57e51f602a3db30b4efaf56496c2c5ee32e4383284083e39df6bc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -2214,7 +2214,7 @@ static int modbus_ascii__frame(modbus_ascii_direction_t dir, uint32_t code, cons
             return r;
         }
         *len = 0u;
-        if (r != MODBUS_ASCII_E_LENGTH) {
+        if (r != MODBUS_ASCII_E_LENGTH && r != MODBUS_ASCII_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

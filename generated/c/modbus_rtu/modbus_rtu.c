@@ -2207,7 +2207,7 @@ static int modbus_rtu__frame(modbus_rtu_direction_t dir, uint32_t code, const ui
             return r;
         }
         *len = 0u;
-        if (r != MODBUS_RTU_E_LENGTH) {
+        if (r != MODBUS_RTU_E_LENGTH && r != MODBUS_RTU_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

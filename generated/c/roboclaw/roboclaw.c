@@ -3228,7 +3228,7 @@ static int roboclaw__frame(roboclaw_direction_t dir, uint32_t code, const uint32
             return r;
         }
         *len = 0u;
-        if (r != ROBOCLAW_E_LENGTH) {
+        if (r != ROBOCLAW_E_LENGTH && r != ROBOCLAW_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define ROBOCLAW_SPEC_SHA256 "c9b7c8a5e9ecfe3f3335caa780e855539e163ed6973955da2a62fb4059b2e901"
+#define ROBOCLAW_SPEC_SHA256 "6e0f92f7747dc66017878fc47a799da6317e9b47f3b5c94e221cbf38dca824a7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef ROBOCLAW_ENABLE_ENCODE

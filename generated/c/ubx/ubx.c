@@ -2041,7 +2041,7 @@ static int ubx__frame(ubx_direction_t dir, uint32_t code, const uint32_t *values
             return r;
         }
         *len = 0u;
-        if (r != UBX_E_LENGTH) {
+        if (r != UBX_E_LENGTH && r != UBX_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "7909a0b6b34011b85e30caf4ae31fb63900a0ca1121bbe99a72f9c6c407d8cd9"
+#define UBX_SPEC_SHA256 "534a2f4219c7817e481759f6ff682c2b7632a0c7fb95f45ef50ba0ae34d86412"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

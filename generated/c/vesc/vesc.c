@@ -2009,7 +2009,7 @@ static int vesc__frame(vesc_direction_t dir, uint32_t code, const uint32_t *valu
             return r;
         }
         *len = 0u;
-        if (r != VESC_E_LENGTH) {
+        if (r != VESC_E_LENGTH && r != VESC_E_RANGE) { /* a length its layout cannot send: the next layout's */
             return r;
         }
     }

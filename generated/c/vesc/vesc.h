@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "6fc9c95e5c3144f9804624a0f1c7f443a709a75cf419f904054cfdb55bc58535"
+#define VESC_SPEC_SHA256 "9f39ec967704b2e23914186df466d99f271fd23e1a3f0614b87f2e5e5a54f2b9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -1317,6 +1317,33 @@ FRAME_ELEMENT = Obj(
             "the whole frame from its header), which counts those too.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
+        "extended": Obj(
+            {
+                "when": Int(
+                    "The value of the one-byte length that says the wider length follows (Xsens MT: 0xFF; MQTT-SN: "
+                    "0x01). It must lie at an end of the short form's range (or outside it): the short form holds "
+                    "every other value of the range that fits a byte.",
+                    minimum=0,
+                    maximum=255,
+                    example=255,
+                ),
+                "type": Str(
+                    "The wider length's type, sent after `when` most significant byte first.",
+                    choices=("u16",),
+                    example="u16",
+                ),
+            },
+            required=("when", "type"),
+            description=(
+                "length: a u8 length that says a larger size in a wider length after it (Xsens MT: `LEN` 0xFF, then "
+                "the size as a big-endian u16; MQTT-SN: 0x01, then the message's length as a u16). Encode sends "
+                "the one-byte form when the value fits it (and its `range`), else `when` and the wider value; "
+                "decode, the stream parser, the C and the Wireshark dissector read either, a long form holding a "
+                "small value too (MQTT-SN allows it). `range` bounds the value in both forms; a length that counts "
+                "itself counts the bytes of the form sent (1, or 3). Not inside a transparency span, nor in a "
+                "layout with optional elements."
+            ),
+        ),
         "description": TEXT,
         "range": ListOf(
             Num(),
@@ -1423,6 +1450,25 @@ FRAME_ELEMENT = Obj(
             "`80 20 02 31 00 22 44` (start channel '1') checks: the CRC of the low 7 bits of 80 20 02 31 00 is 0x2222, "
             "sent as 22 44. A library's reflected polynomial (Kangaroo's 0x22F0) is `poly` reflected over the width "
             "(0x03D1); the check value is of '123456789', whose bytes are 7-bit already.",
+        ),
+        (
+            "A one-byte length with a long form (Xsens MT: `FA FF MID LEN DATA CHECKSUM`, LEN 0..254 the data's size, "
+            "LEN FF then the size as a big-endian u16 for 255..2048 bytes)",
+            {
+                "len": {
+                    "role": "length",
+                    "type": "u8",
+                    "extended": {"when": 0xFF, "type": "u16"},
+                    "range": [0, 2048],
+                }
+            },
+            "GoToConfig is `FA FF 30 00 D1`; an MTData2 (0x36) of 255 data bytes is `FA FF 36 FF 00 FF` then the data "
+            "and its checksum: LEN FF is the marker, so 255 bytes already take the long form, and the checksum, a "
+            "`sum` with `negate: true` over [bid, data], covers the long form's three bytes. MQTT-SN's length counts "
+            "the whole message, itself too, 0x01 then a u16 from 256 bytes on: `length: {role: length, type: u8, "
+            "extended: {when: 0x01, type: u16}, counts: [length, content], range: [2, 65535]}` (the one-byte form "
+            "2..255, the long one 3 bytes of the count). Encode picks the one-byte form whenever the value fits it; "
+            "a long form holding a small value is read as well.",
         ),
         (
             "Error replies told by their status (SHDLC's state byte: an execution error code in bits 6..0, the "

@@ -67,6 +67,11 @@ class Element:
     limits: tuple[int, int] | None = None
     # value: its constant bit fields, (name, lowest bit, mask, constant) each; folded into `need` by the generator
     fixed: tuple[tuple[str, int, int, int], ...] = ()
+    # length: a one-byte length's long form (`extended:`), (marker, wider size, the long form's adds, lowest and
+    # highest value of the one-byte form, of the wider one); a Layout holding one hands each frame to its two
+    # variants (see `_extended`)
+    extended: tuple[int, int, int, int, int, int, int] | None = None
+    lead: int = 0  # length (a long form's variant): the marker above the value read (marker << 8 * wider size)
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -82,7 +87,12 @@ class Element:
         limits = self.limits
         if limits is None or limits[0] <= value <= limits[1]:
             return ""
-        return f"{self.name} = {value} is outside its range {limits[0]}..{limits[1]}"
+        lead = self.lead
+        if lead and value >> 8 * (self.size - 1) != lead >> 8 * (self.size - 1):
+            return (
+                f"{self.name} form is {value >> 8 * (self.size - 1):#04x}, expected {lead >> 8 * (self.size - 1):#04x}"
+            )
+        return f"{self.name} = {value - lead} is outside its range {limits[0] - lead}..{limits[1] - lead}"
 
 
 @dataclass(frozen=True)
@@ -97,6 +107,9 @@ class Layout:
     conditions: tuple[tuple[int, int, Literal["little", "big"], int, int], ...] = ()  # a variant's flag bits:
     # (offset, size, byte order, mask, bits) of each flag element, which a frame must match to be read in it
     error: bool = False  # its frames refuse their request (an error header): their code is ERROR_REPLY's
+    # a variant's bytes a frame must not have to be read in it: (offset, byte) each (an extended length's one-byte
+    # form, whose marker byte says the long form)
+    unless: tuple[tuple[int, int], ...] = ()
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -110,7 +123,9 @@ class Layout:
         object.__setattr__(self, "command", kinds.index("command") if "command" in kinds else None)
         object.__setattr__(self, "length", kinds.index("length") if "length" in kinds else None)
         optional = [i for i, k in enumerate(kinds) if k == "optional"]
-        object.__setattr__(self, "_found", self._variants(optional[0]) if optional else (self,))
+        extended = [i for i, e in enumerate(self.elements) if e.kind == "length" and e.extended is not None]
+        found = self._variants(optional[0]) if optional else self._extended(extended[0]) if extended else (self,)
+        object.__setattr__(self, "_found", found)
         # a command element whose frames carry an expression of the code (`code:`): the codes sent, both ways
         wire = self.elements[self.command].wire if self.command is not None else ()
         object.__setattr__(self, "to_wire", dict(wire))
@@ -274,12 +289,43 @@ class Layout:
         )
         return (*with_it.variants, *without.variants)
 
+    def _extended(self, k: int) -> tuple[Layout, ...]:
+        """The plain layouts of a layout whose length has a long form (`extended:`): the one-byte form (its values
+        less the marker; a frame with the marker byte there is not read in it), then the long form, read as one
+        big-endian length of 1 + wider size bytes whose top byte is the marker: the marker shifted above the value
+        goes into its adds and limits, so every reader of lengths (sizing, checks, encode) takes it as it is."""
+        element = self.elements[k]
+        assert element.extended is not None
+        marker, size, adds, short_low, short_high, long_low, long_high = element.extended
+        offset = self.offset(k)
+        assert offset is not None  # the spec language keeps it before anything variable
+        lead = marker << 8 * size
+        short = replace(element, extended=None, limits=(short_low, short_high))
+        long = replace(
+            element,
+            extended=None,
+            size=1 + size,
+            endian="big",
+            adds=adds + lead,
+            limits=(lead + long_low, lead + long_high),
+            lead=lead,
+        )
+
+        def form(each: Element, **changes: Any) -> Layout:
+            elements = self.elements[:k] + (each,) + self.elements[k + 1 :]
+            return Layout(self.name, elements, self.transparency, self.codes, self.present, error=self.error, **changes)
+
+        return (
+            form(short, conditions=self.conditions, unless=((offset, marker),)),
+            form(long, conditions=(*self.conditions, (offset, 1, "big", 0xFF, marker))),
+        )
+
     def admits(self, frame: bytes) -> bool:
         """Whether `frame` has this variant's flag bits (a plain layout admits every frame)."""
         for offset, size, endian, mask, bits in self.conditions:
             if len(frame) < offset + size or int.from_bytes(frame[offset : offset + size], endian) & mask != bits:
                 return False
-        return True
+        return all(len(frame) > offset and frame[offset] != byte for offset, byte in self.unless)
 
     def variant(self, frame: bytes) -> Layout:
         """The plain layout `frame` is read in: the variant whose flag bits it has (DecodeError: none)."""
@@ -306,7 +352,13 @@ class Layout:
         `request`: the bytes of the request's elements by name, for a checksum that takes some in first; `extras`:
         the optional elements' bytes by name (None or left out: not sent)."""
         if self.variants[0] is not self:
-            return self._sending(values, extras).wrap(content, code, values, request, extras)
+            sending = self._sending(values, extras)
+            for variant in sending[:-1]:  # an extended length's one-byte form first: the long form if it does not fit
+                try:
+                    return variant.wrap(content, code, values, request, extras)
+                except EncodeError:
+                    pass
+            return sending[-1].wrap(content, code, values, request, extras)
         plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
         elements = self.elements
         plain: list[bytes] = list(plan["template"])  # constants in place, zeros for what is computed below
@@ -351,9 +403,9 @@ class Layout:
             plain[index] = self._checksum(element, covered)
         return self._wire(plain, wire, 0, len(elements) - 1)
 
-    def _sending(self, values: tuple[int, ...], extras: Mapping[str, bytes | None] | None) -> Layout:
-        """The variant that sends the optional elements given in `extras`; EncodeError where a value flag element's
-        bit (the message's own value) says otherwise."""
+    def _sending(self, values: tuple[int, ...], extras: Mapping[str, bytes | None] | None) -> tuple[Layout, ...]:
+        """The variants that send the optional elements given in `extras` (one, or an extended length's two forms);
+        EncodeError where a value flag element's bit (the message's own value) says otherwise."""
         given = frozenset(name for name, data in (extras or {}).items() if data is not None)
         flags = dict(zip(self.values, values, strict=True))
         for element in self.elements:
@@ -367,7 +419,7 @@ class Layout:
                         f"{element.mask:#04x} {state}"
                     )
         known = {e.name for e in self.elements if e.kind == "optional"}
-        return next(v for v in self.variants if v.present == given & known)
+        return tuple(v for v in self.variants if v.present == given & known)
 
     def _covered(self, plain: list[bytes], wire: dict[int, bytes], element: Element) -> bytes:
         """The bytes a checksum covers: its span's, less the elements it skips (which lie outside any stuffing)."""
@@ -450,7 +502,9 @@ class Layout:
             if outside:  # as the stream parser, which sees no frame there
                 raise DecodeError(outside)
             if value != counted:
-                raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
+                raise DecodeError(
+                    f"{element.name} says {value - element.lead} but the frame holds {counted - element.lead}"
+                )
         for index, element in plan["checksums"]:
             covered = self._covered(plain, wire, element)
             if element.request:

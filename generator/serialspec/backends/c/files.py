@@ -922,7 +922,10 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
             limits = length_limits(e)
             if limits is not None:  # as the stream parser, which sees no frame there (it checked it when sized)
                 low, high = limits
-                refused = f"({value}) < {low}u || ({value}) > {high}u" if low else f"({value}) > {high}u"
+                tests = [f"({value}) < {low}u"] if low else []
+                if high < (1 << 8 * sizes[i]) - 1:  # (an extended length's one-byte form may hold up to 255)
+                    tests.append(f"({value}) > {high}u")
+                refused = " || ".join(tests)
                 lines.append(f"    if ({skip}({refused})) {{ return {P}_E_RANGE; }} /* {e.name}: its range */")
             lines.append(
                 f"    if ({skip}(int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
@@ -1361,7 +1364,7 @@ static size_t {p}__least({p}_direction_t dir)
         if opt
         else ""
     )
-    admits = f"{p}__admits(dir, k, frame, len)" if opt else "1"
+    admits = f"{p}__admits(dir, k, frame, len)" if optional.splits(ctx) else "1"
     taking = f"""    k = 0u;
     if (!{P}__SINGLE && count != 1u) {{
         int headed = 0; /* a header matched: a frame no variant admits is too short for the flags it needs */
@@ -1433,7 +1436,7 @@ static size_t {p}__least({p}_direction_t dir)
         r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg});
 {asking.refusal(ctx, f"{p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen{pre_arg})")}
     }} else {other}"""
-    admits_fn = optional.admits(ctx) if opt else ""
+    admits_fn = optional.admits(ctx) if opt else optional.admits_function(ctx) if optional.splits(ctx) else ""
     unwrap_tail = "const uint8_t **content, size_t *clen"
     if asks:
         unwrap_tail = "const uint8_t **content,\n                          size_t *clen" + pre_param
@@ -1741,7 +1744,7 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
             return r;
         }}
         *len = 0u;
-        if (r != {P}_E_LENGTH) {{
+        if (r != {P}_E_LENGTH && r != {P}_E_RANGE) {{ /* a length its layout cannot send: the next layout's */
             return r;
         }}
     }}

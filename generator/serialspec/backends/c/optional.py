@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, replace
 
 from serialspec.backends.c.emit import Ctx, Member, ident
 from serialspec.backends.common.frames import optional_elements
-from serialspec.lang.model import Direction, FrameElement, FrameLayout, Protocol
+from serialspec.lang.model import SCALARS, Direction, FrameElement, FrameLayout, Protocol
 from serialspec.lang.model.framing import VALUE_ROLES
 
 EXTRA = "extra"  # the role of an optional element in a variant that sends it: fixed bytes from the message
@@ -26,6 +26,7 @@ class Variant:
     present: frozenset[str] = frozenset()
     conditions: tuple[tuple[int, int, bool, int, int], ...] = ()  # (offset, size, big-endian, mask, bits)
     needs: dict[str, tuple[int, int]] = field(default_factory=dict)  # value element: (mask, bits) it must have
+    unless: tuple[tuple[int, int], ...] = ()  # (offset, byte) a frame must not have (an extended length's marker)
 
     @property
     def bit_of(self) -> dict[str, tuple[int, int]]:
@@ -48,7 +49,7 @@ def split(layout: FrameLayout, origin: int, variant: Variant | None = None) -> t
     elements = layout.elements
     k = next((i for i, e in enumerate(elements) if e.role == "optional"), -1)
     if k < 0:
-        return (variant,)
+        return extended_forms(variant)
     element = elements[k]
     flag_name, mask = element.present_if
     f = layout.index(flag_name)
@@ -76,6 +77,40 @@ def split(layout: FrameLayout, origin: int, variant: Variant | None = None) -> t
         _plain(layout, left), origin, variant.present, (*variant.conditions, (*condition, 0)), needs_clear
     )
     return (*split(with_it.layout, origin, with_it), *split(without.layout, origin, without))
+
+
+def extended_forms(variant: Variant) -> tuple[Variant, ...]:
+    """A layout whose length has a long form (`extended:`) as its two plain layouts, as runtime/framing.py's
+    Layout._extended: the one-byte form (not read where the marker byte is), then the long form as one big-endian
+    length of 1 + wider size bytes, the marker shifted above its value in its adds and range."""
+    layout = variant.layout
+    k = next((i for i, e in enumerate(layout.elements) if e.role == "length" and e.extended is not None), -1)
+    if k < 0:
+        return (variant,)
+    element = layout.elements[k]
+    x = element.extended
+    assert x is not None and element.type is not None
+    offset = _offset(layout, k)
+    lead = x.marker << 8 * x.size
+    short = replace(element, extended=None, minimum=float(x.short[0]), maximum=float(x.short[1]))
+    long = replace(
+        element,
+        extended=None,
+        type=SCALARS[f"u{8 * (1 + x.size)}"],
+        size=1 + x.size,
+        endian=">",
+        adds=x.adds + lead,
+        minimum=float(lead + x.long[0]),
+        maximum=float(lead + x.long[1]),
+    )
+
+    def form(each: FrameElement) -> FrameLayout:
+        return _plain(layout, (*layout.elements[:k], each, *layout.elements[k + 1 :]))
+
+    return (
+        replace(variant, layout=form(short), unless=(*variant.unless, (offset, x.marker))),
+        replace(variant, layout=form(long), conditions=(*variant.conditions, (offset, 1, True, 0xFF, x.marker))),
+    )
 
 
 def _plain(layout: FrameLayout, elements: tuple[FrameElement, ...]) -> FrameLayout:
@@ -128,7 +163,12 @@ def members(ctx: Ctx, direction: Direction) -> list[Member]:
     return found
 
 
-def admits(ctx: Ctx) -> str:
+def splits(ctx: Ctx) -> bool:
+    """Some layout is read as several plain ones (optional elements, an extended length): p__admits tells them."""
+    return ctx.original is not None  # (expanded() gives the spec itself where no layout splits)
+
+
+def admits_function(ctx: Ctx) -> str:
     """`p__admits(dir, k, frame, n)`: 1 when the frame has variant k's flag bits (Layout.admits)."""
     p, P = ctx.p, ctx.P
     cases = []
@@ -142,6 +182,7 @@ def admits(ctx: Ctx) -> str:
                     f"((uint32_t)f[{offset + i}u] << {8 * (size - 1 - j)}u)" for j, i in enumerate(order)
                 )
                 tests.append(f"n >= {offset + size}u && (({value}) & {mask}UL) == {bits}UL")
+            tests += [f"n > {offset}u && f[{offset}u] != 0x{byte:02x}u" for offset, byte in v.unless]
             if tests:
                 rows.append(f"        case {k}u:\n            return {' && '.join(tests)};")
         if rows:
@@ -151,9 +192,12 @@ def admits(ctx: Ctx) -> str:
                 + "\n        default:\n            break;\n        }\n        break;"
             )
     return f"""
-/* 1 when frame f[0..n) has the flag bits of the direction's layout k (the optional elements it sends). */
+/* 1 when frame f[0..n) has the flag bits of the direction's layout k (the optional elements it sends; an extended
+ * length's marker byte, or not). */
 static int {p}__admits({p}_direction_t dir, uint8_t k, const uint8_t *f, size_t n)
 {{
+    (void)f;
+    (void)n;
     switch (dir) {{
 {chr(10).join(cases)}
     default:
@@ -161,6 +205,15 @@ static int {p}__admits({p}_direction_t dir, uint8_t k, const uint8_t *f, size_t 
     }}
     return 1;
 }}
+"""
+
+
+def admits(ctx: Ctx) -> str:
+    """`p__admits(dir, k, frame, n)` and the optional elements' helpers (see admits_function)."""
+    p = ctx.p
+    return (
+        admits_function(ctx)
+        + f"""
 
 /* Where the optional elements of layout k lie in frame f[0..n) (NULL: not sent), by their order in the direction. */
 static void {p}__extras({p}_direction_t dir, uint8_t k, const uint8_t *f, size_t n, const uint8_t **at)
@@ -179,6 +232,7 @@ static void {p}__extra(bool *has, uint8_t *bytes, const uint8_t *at, size_t size
     }}
 }}
 """
+    )
 
 
 def extras_cases(ctx: Ctx) -> str:

@@ -70,7 +70,14 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         limits=length_limits(element) if kind == "length" else None,
         need=fixed_bits(element.bits) if kind == "value" else (0, 0),
         fixed=tuple((b.name, b.low, b.mask, b.const) for b in element.bits if b.const is not None and kind == "value"),
+        extended=extended_form(element),
     )
+
+
+def extended_form(element: FrameElement) -> tuple[int, int, int, int, int, int, int] | None:
+    """A length's long form (`extended:`) as the engine's Element holds it (None: the length has none)."""
+    x = element.extended
+    return None if x is None else (x.marker, x.size, x.adds, *x.short, *x.long)
 
 
 def length_limits(element: FrameElement) -> tuple[int, int] | None:

@@ -555,6 +555,15 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
             endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
             kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
+        if e.extended is not None:  # a long form after a marker (`extended:`)
+            x = e.extended
+            wide = f"u{8 * x.size}"
+            long_form = (
+                f"{x.short[0]}..{x.short[1]} in one byte; larger, the long form: {x.marker:#04x} then the value as a "
+                f"big-endian {wide} ({x.long[0]}..{x.long[1]}), everything after it {x.size} bytes later"
+                + (f", its count + {x.adds} (its own bytes)" if x.adds != e.adds else "")
+            )
+            description = ". ".join(p for p in (long_form, description) if p)
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
@@ -680,7 +689,9 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
         if e.kind == "command":
             value = example.command
         elif e.kind == "length":
-            value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
+            counted = f"bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`"
+            long_form = f"; {part[0]:#04x}: the long form" if e.lead else ""  # (an extended length's marker byte)
+            value = f"{e.unpack(part) - e.lead} ({counted}{long_form})"
         elif e.kind == "checksum":
             value = "verifies"
         elif e.kind == "extra":

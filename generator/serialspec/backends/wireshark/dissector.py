@@ -232,8 +232,9 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
     model = {e.name: e for e in layout.elements}
     for runtime in engine.elements:
         element = model[runtime.name]
-        item: dict[str, Any] = {"name": element.name, "role": element.role, "size": element.size or 0}
-        item["big"] = element.endian == ">"
+        # (the size and byte order the variant's: an extended length's long form is 1 + its wider size, big-endian)
+        item: dict[str, Any] = {"name": element.name, "role": element.role, "size": runtime.size}
+        item["big"] = runtime.endian == "big"
         if element.fixed:
             item["constant"] = runtime.constant  # a flag element's: with the variant's bit
         if runtime.need != (0, 0):
@@ -247,7 +248,7 @@ def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
             item["wire"] = {sent: code for code, sent in element.wire}
         if element.role == "length":
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
-            item["adds"] = element.adds
+            item["adds"] = runtime.adds  # (an extended length's long form: the marker above its value added)
             if runtime.limits is not None:  # its range: a candidate whose length is outside it is no frame
                 item["limits"] = list(runtime.limits)
         if element.checksum is not None:

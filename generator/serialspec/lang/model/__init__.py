@@ -191,6 +191,9 @@ from serialspec.lang.model.framing import (
     ErrorReply as ErrorReply,
 )
 from serialspec.lang.model.framing import (
+    ExtendedLength as ExtendedLength,
+)
+from serialspec.lang.model.framing import (
     FrameElement as FrameElement,
 )
 from serialspec.lang.model.framing import (

@@ -28,6 +28,17 @@ class Checksum:
     function: str = ""
 
 
+@frozen
+class ExtendedLength:
+    """A one-byte length's long form (`extended:`): the byte `marker`, then the size as `size` big-endian bytes."""
+
+    marker: int  # the short form's value that says the wider length follows (Xsens MT: 0xFF; MQTT-SN: 0x01)
+    size: int  # bytes of the wider length
+    adds: int  # the long form's `adds` (a length that counts itself counts its wider bytes too)
+    short: tuple[int, int]  # the values the one-byte form holds (the range's, less the marker)
+    long: tuple[int, int]  # the values the wider one holds (the range's)
+
+
 VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
 
 
@@ -59,6 +70,7 @@ class FrameElement:
     code: str = ""
     wire: tuple[tuple[int, int], ...] = ()
     digit: bool = False  # `type: u4`: one hex digit of a hex-ASCII span (a byte 0..15 in the plain bytes)
+    extended: ExtendedLength | None = None  # length: a long form after a marker value (`extended:`)
 
     @property
     def fixed(self) -> bool:

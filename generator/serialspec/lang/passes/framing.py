@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     VALUE_ROLES,
     Checksum,
     Direction,
+    ExtendedLength,
     FrameElement,
     FrameLayout,
     Framing,
@@ -214,8 +215,11 @@ class FramingPass(FieldResolver):
         low, high = (scalar.minimum, scalar.maximum) if scalar else (0.0, 0.0)
         if item.get("type") == "u4" and scalar:
             low, high = 0.0, 15.0
+        wide = self.extended_type(item, role, scalar, path)  # a length's long form (`extended:`): its range's type
+        if wide is not None:
+            low, high = wide.minimum, wide.maximum
         if "range" in item and scalar:
-            low, high = self.bounds(scalar, False, item["range"], (*path, "range"))
+            low, high = self.bounds(wide or scalar, False, item["range"], (*path, "range"))
             if item.get("type") == "u4" and not 0 <= low <= high <= 15:
                 self.error((*path, "range"), f"range [{low:g}, {high:g}] does not fit u4 (0..15)")
         broadcast = item.get("broadcast")
@@ -247,6 +251,7 @@ class FramingPass(FieldResolver):
         for key, allowed in (
             ("adds", "length"),
             ("counts", "length"),
+            ("extended", "length"),
             ("covers", "checksum"),
             ("sequence", "value"),
             ("ok", "status"),
@@ -281,7 +286,45 @@ class FramingPass(FieldResolver):
             checksum=checksum,
             code=" ".join(str(item.get("code", "")).split()),
             digit=item.get("type") == "u4",
+            extended=self.extended(item["extended"], wide, int(low), int(high), path) if wide is not None else None,
         )
+
+    def extended_type(
+        self, item: dict[str, Any], role: str, scalar: ScalarType | None, path: Path
+    ) -> ScalarType | None:
+        """The wider type of a length's long form (`extended:`), None without one (or on a mistake, said here)."""
+        given = item.get("extended")
+        if "extended" not in item or role != "length" or scalar is None:
+            return None
+        if scalar.name != "u8":
+            self.error(
+                (*path, "type"), f"an extended length is one byte unless it says more: type u8, not {scalar.name}"
+            )
+            return None
+        wide = given.get("type") if isinstance(given, dict) else None  # (a malformed one: the grammar said so)
+        return SCALARS[wide] if wide in SCALARS else SCALARS["u16"]
+
+    def extended(self, given: Any, wide: ScalarType, low: int, high: int, path: Path) -> ExtendedLength | None:
+        """The long form: its marker, size and the values each form holds (`adds` is the layout's, see layout());
+        None for a malformed one (the grammar said what is wrong)."""
+        if not isinstance(given, dict) or not isinstance(given.get("when"), int):
+            return None
+        marker = given["when"]
+        short_low, short_high = low, min(high, 255)
+        if short_low <= marker <= short_high:
+            if marker == short_high:
+                short_high -= 1
+            elif marker == short_low:
+                short_low += 1
+            else:
+                self.error(
+                    (*path, "extended", "when"),
+                    f"{marker} lies inside the one-byte form's values {short_low}..{short_high}: the marker must be "
+                    "the lowest or highest of them, or outside them (narrow `range`)",
+                )
+        if short_low > short_high:
+            self.error((*path, "range"), "the one-byte form holds no value of the range: drop `extended`")
+        return ExtendedLength(marker, wide.size, 0, (short_low, short_high), (low, min(high, int(wide.maximum))))
 
     def checksum(
         self, item: dict[str, Any], name: str, scalar: ScalarType, endian: Literal["<", ">"], path: Path
@@ -481,6 +524,13 @@ class FramingPass(FieldResolver):
                     fixed = sum(e.size or 0 for e in before) + element.type.size
                     a, counts = index + 1, (names[index + 1], counts[1])
                     element = replace(element, adds=element.adds + fixed)
+                    if element.extended is not None:  # it counts its wider bytes too in the long form
+                        grown = element.adds + element.extended.size
+                        element = replace(element, extended=replace(element.extended, adds=grown))
+                elif element.extended is not None:
+                    element = replace(element, extended=replace(element.extended, adds=element.adds))
+                if element.extended is not None:
+                    self.extended_place(elements, index, content_index, transparency, e_path)
                 if index >= a or (transparency and index > t_last):
                     raise self.fail(e_path, "the length must come before what it counts (and before the span's end)")
                 within = transparency is not None and t_first <= a and b <= t_last  # it counts plain bytes
@@ -536,6 +586,24 @@ class FramingPass(FieldResolver):
             )
         flagged = any("error_flag" in item or "error_bits" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
+
+    def extended_place(
+        self,
+        elements: list[FrameElement],
+        index: int,
+        content_index: int,
+        transparency: Transparency | None,
+        path: Path,
+    ) -> None:
+        """An extended length lies at a fixed offset, before the content and outside any transparency span (its
+        marker tells the long form at that offset), in a layout without optional elements."""
+        t_first = elements.index(next(e for e in elements if e.name == transparency.first)) if transparency else -1
+        if (transparency is not None and index >= t_first) or 0 <= content_index < index:
+            raise self.fail(
+                (*path, "extended"), "an extended length comes before the content and any transparency span"
+            )
+        if any(e.role == "optional" for e in elements):
+            raise self.fail((*path, "extended"), "an extended length in a layout with optional elements: not supported")
 
     def optional(
         self,
@@ -634,6 +702,7 @@ class FramingPass(FieldResolver):
             and "content" in roles
             and length is not None
             and length.size == 1
+            and length.extended is None
             and length.counts == (names[content_index], names[content_index])
             and roles.index("length") < content_index
             and len(checksums) == 1

@@ -98,6 +98,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
         args += [f"flag={e.flag}", f"mask={e.mask:#04x}"]
     if e.adds:
         args.append(f"adds={e.adds}")
+    if e.extended is not None:
+        args.append(f"extended={e.extended}")
     if e.kind == "checksum":
         assert element.checksum is not None
         args.append(f"checksum={checksum_name(element.checksum)}")

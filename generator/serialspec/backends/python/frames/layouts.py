@@ -217,6 +217,8 @@ class StraightLayouts:
 def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
     """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
     full = runtime_layouts(protocol, direction)
+    if any(e.extended is not None for layout in full for e in layout.elements):
+        return None  # a length with a long form (`extended:`): the engine's variants, told apart by its marker
     layouts = tuple(layout.variants[-1] for layout in full)  # with optional elements: the variant without them
     diverts = tuple(
         (offset, size, endian, mask) for layout in layouts for offset, size, endian, mask, _ in layout.conditions

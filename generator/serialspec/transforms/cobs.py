@@ -68,6 +68,8 @@ def _decode(data: bytes, start: int, end: int, count: int | None) -> tuple[bytes
         position += code
         if code < 0xFF and not (position >= len(data) or data[position] == 0):
             plain.append(0)  # the 00 the code byte stands for (none after the last run)
+            if len(plain) == count:  # the span's last plain byte: the code byte after it (which makes it a 00,
+                return bytes(plain), position + 1 - start, False  # its run the rest) is the span's too
         elif code < 0xFF and count is not None and position >= end:
             return bytes(plain), position - start, False  # the span may go on: is the 00 there or not?
     return bytes(plain[:count]), position - start, False
@@ -235,6 +237,9 @@ static long NAME_prefix(const uint8_t *b, size_t start, size_t avail, size_t cou
                 dst[n - from] = 0u; /* the 00 the code byte stands for */
             }
             n++;
+            if (n == count) {
+                return (long)(pos + 1u - start); /* that 00 is the last: the code byte making it one is the span's */
+            }
         } else if (code < 0xFFu && pos >= avail) {
             return n >= count ? (long)(pos - start) : -2L; /* the span may go on: is the 00 there or not? */
         }

@@ -573,10 +573,12 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         t = self.text
         if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
             own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
+        labelled = layout is not None and layout.labelled  # written by labelled_writes
         for item in _sent(m):
             if isinstance(item, TextField):
                 checks.append(self.check(item, "m->", own, rest_own))
-                writes.append(self.write(item, "m->", part))
+                if not labelled:
+                    writes.append(self.write(item, "m->", part))
                 continue
             name = ident(item.name)
             groups = f"{item.count}u" if item.count else f"m->{name}_count"
@@ -586,7 +588,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 checks.append(f"    if ({groups} > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
             inner = "\n".join(self.check(f, f"m->{name}[g].", own) for f in item.fields).replace("\n", "\n    ")
             checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
-            if layout is not None and layout.labelled:
+            if labelled:
                 continue
             inner = "\n".join(
                 self.write(f, f"m->{name}[g].", (f"g == 0u ? {part} : {joined}" if k == 0 else joined) if part else "")
@@ -595,7 +597,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
         head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
         written = "\n".join(writes)
-        if layout is not None and layout.labelled:
+        if layout is not None and labelled:
             written = self.labelled_writes(m, layout)
             head += ", in its own text with labels"
         elif layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text

@@ -38,7 +38,7 @@ from test_c_backend import (
     m32_builds,
     warning_flags,
 )
-from test_language_matrix import TEXT_CASE
+from test_language_matrix import LABELLED_COMMANDS, TEXT_CASE
 from test_text_frames import sentence_values
 
 pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
@@ -96,6 +96,19 @@ MATRIX["commands"] |= {
         },
     },
 }
+# messages in their own text with labels (test_language_matrix.LABELLED_COMMANDS): inside a start and an ending (here
+# `<` and `>`, a character of the responses' line ending too), found in any order, one labelled with the code right
+# after it, labelled repeats, a text; found by their code, labels glued to their values without a separator (the field
+# labelled with the code not the first declared) and with one (a request: checksummed, a text too)
+MATRIX["commands"] |= copy.deepcopy(LABELLED_COMMANDS)
+REPORTED = MATRIX["commands"]["report"]["response"]["fields"]
+MATRIX["commands"]["report"]["response"]["fields"] = {"t": {"label": "TX", "type": "text"}, **REPORTED}
+MOVED = MATRIX["commands"]["move"]["response"]["fields"]
+MOVED["time"]["range"] = [0, 9999]
+MATRIX["commands"]["move"]["response"]["fields"] = {"time": MOVED.pop("time"), **MOVED}
+MATRIX["commands"]["words"] = {"code": "GW", "request": MATRIX["commands"]["words"]["response"]}
+MATRIX["commands"]["words"]["request"].pop("unsolicited")
+MATRIX["commands"]["words"]["request"]["fields"]["w"] = {"label": "W", "type": "text"}
 # frames without a start character, every line a frame (Marlin's `ok`, ODrive's ASCII protocol), requests ended by
 # CR LF, responses by CR CR `>` (an ELM327's); an
 # optional XOR checksum written in decimal after a separator in requests (ODrive's `r vbus_voltage *93`); a reply of
@@ -142,6 +155,18 @@ LINES["commands"] |= {
                 "b": {"type": "integer", "base": 16, "width": 2, "range": [0, 255]},
                 "note": "text",
             },
+        },
+    },
+}
+# labels after `named` in a message found by its code (`KV|A=1|R=1,2`)
+LINES["commands"]["pairs"] = {
+    "code": "KV",
+    "response": {
+        "unsolicited": True,
+        "text": {"separator": "|", "named": "=", "list": ","},
+        "fields": {
+            "a": {"label": "A", "type": "integer"},
+            "r": {"label": "R", "type": "repeat", "max_count": 2, "fields": {"x": "integer", "y": "text"}},
         },
     },
 }
@@ -474,6 +499,36 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
     if reply is not None and name == "c_text_lines":  # answered once: the next line of values is no reply any more
         line = b.framing.encode(reply.code, {"level": 7}, b.framing.talkers[0], direction=reply.direction)
         stream_agrees(b, reply.direction, line + line, "1", expect=reply)
+
+
+# bodies of frames of messages whose fields have labels (runtime/text.py frames them): in any order, the value
+# labelled with the code right after it or left out, empty values, and what decode refuses (a label unknown or sent
+# twice, a repeat's values of the wrong number, a part without `named`, a value not of its kind)
+REPORT = ("=3|P=1.5,2|LV=7", "", "=", "=x", "|", "|LV=7|LV=8", "|Q=1", "|LV", "|P=1", "|P=,", "|P=1,2,3", "|=3")
+REPORT += ("|S=1,N,2,S", "|S=1,N,2", "|S=1,N,2,S,3,N,4,S", "|TX=a=b,c|S=,", "=1|RP=2")
+MOVE = ("1T2SD3.5", "T2", "SD-1T5", "", "1T2T3", "1X2", "1..2", "+1T-0", "T")
+WORDS = (";Y2;X1.5", "", ";", ";X", ";Q1", ";X1;X2", ";Wa=b", ";Y2;;X1", ";W")
+LABELLED = {
+    "c_text_matrix": [("response", f"5<ARP{rest}>") for rest in REPORT]
+    + [("response", "5<AXY=3>"), ("response", "<BRP=1|LV=2>")]
+    + [("response", f"5AMV{rest}") for rest in MOVE]
+    + [("request", f"5AGW{rest}") for rest in WORDS],
+    "c_text_lines": [
+        ("response", f"AKV{rest}") for rest in ("|R=1,a,2,b|A=3", "", "|", "|A", "|R=1", "|A=1|A=2", "|R=1,a,2,b,3,c")
+    ],
+}
+
+
+@pytest.mark.parametrize("name", ["c_text_matrix", "c_text_lines"])
+def test_labels_in_any_order_and_refused_as_python_refuses(name: str) -> None:
+    """Frames of the messages with labels the random messages do not make (those write every label in order):
+    decoded, refused and encoded again as Python does, and read so by the stream parser."""
+    b = built(name)
+    found = [(d, b.framing.frame(body, d)) for d, body in LABELLED[name]]
+    for direction, frame in found:
+        check_decode(b, frame, direction)
+    for direction in directions(b):
+        stream_agrees(b, direction, b"".join(f for d, f in found if d == direction), "1,3,7")
 
 
 @pytest.mark.parametrize("build", [b for b in BUILDS[:3] if b != DEFAULT_BUILD])

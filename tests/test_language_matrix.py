@@ -1996,6 +1996,52 @@ TEXT_CASE: dict[str, Any] = {
 }
 
 
+# Messages in their own text with labels (each output's tests add them to the text case): inside a start and an ending,
+# found in any order, a value after the code labelled with it (GRBL's `<Hold:0|MPos:…>`), labelled repeats; found by
+# their code, labels glued to their values without a separator, the first labelled with the code (LSS's
+# `D1800T1500`), and with one (G-code's `G1 X10.5 Y-3`).
+LABELLED_COMMANDS: dict[str, Any] = {
+    "report": {
+        "code": "RP",
+        "response": {
+            "unsolicited": True,
+            "text": {"start": "<", "end": ">", "separator": "|", "named": "=", "list": ","},
+            "fields": {
+                "sub": {"label": "RP", "type": "integer", "range": [0, 9]},  # after the code: `<RP=3|…>`
+                "lvl": {"label": "LV", "type": "integer", "range": [0, 99]},
+                "pos": {
+                    "label": "P",
+                    "type": "repeat",
+                    "count": 2,
+                    "fields": {"x": {"type": "decimal", "precision": 1}},
+                },
+                "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
+            },
+        },
+    },
+    "move": {
+        "code": "MV",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": "", "separator": ""},
+            "fields": {
+                "at": {"label": "MV", "type": "integer"},
+                "time": {"label": "T", "type": "integer"},
+                "speed": {"label": "SD", "type": "decimal"},
+            },
+        },
+    },
+    "words": {
+        "code": "GW",
+        "response": {
+            "unsolicited": True,
+            "text": {"named": ""},
+            "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
+        },
+    },
+}
+
+
 def text_c_compiles(files: dict[str, str], tmp_path: Path) -> None:
     """The text case's C compiles without a warning under the shipped specs' flags."""
     from test_c_backend import FLAGS, GCC
@@ -2186,48 +2232,25 @@ def test_an_answer_ended_by_another_line_through_every_output(many: bool, tmp_pa
 
 def test_a_message_s_own_text_layout_through_every_output(tmp_path: Path) -> None:
     """`text:` (a message's own start, end, separator, labels and lists; a field labelled with the code, its value right
-    after the code) beside the case's plain sentences: C refuses it in one line (tests/test_wireshark_text.py holds the
-    dissector to decode); the markdown page shows the labels; the generated package round-trips random messages (labels
-    left out where a value is None) and finds them byte by byte among garbage and other sentences; the simulator sends
-    it."""
-    from serialspec.backends import Unsupported, emit
+    after the code) beside the case's plain sentences: the C compiles (tests/test_c_text.py holds it to Python,
+    tests/test_wireshark_text.py the dissector to decode); the markdown page shows the labels; the generated package
+    round-trips random messages (labels left out where a value is None) and finds them byte by byte among garbage and
+    other sentences; the simulator sends it."""
+    from serialspec.backends import emit
     from serialspec.runtime.text import TextField, TextRepeat
     from test_text_frames import sentence_values
 
     case = copy.deepcopy(TEXT_CASE)
-    case["commands"]["report"] = {
-        "code": "RP",
-        "title": "A report in its own text",
-        "response": {
-            "unsolicited": True,
-            "text": {"start": "<", "end": ">", "separator": "|", "named": "=", "list": ","},
-            "fields": {
-                "sub": {
-                    "label": "RP",
-                    "type": "integer",
-                    "range": [0, 9],
-                },  # after the code: `<RP=3|…>` (GRBL's Hold:0)
-                "lvl": {"label": "LV", "type": "integer", "range": [0, 99]},
-                "pos": {
-                    "label": "P",
-                    "type": "repeat",
-                    "count": 2,
-                    "fields": {"x": {"type": "decimal", "precision": 1}},
-                },
-                "sats": {"label": "S", "type": "repeat", "max_count": 3, "fields": {"n": "integer", "s": "side"}},
-            },
-        },
-    }
+    case["commands"]["report"] = copy.deepcopy(LABELLED_COMMANDS["report"]) | {"title": "A report in its own text"}
     case["device"]["sends"] = {"report": {"every": 100, "values": {"lvl": "level"}}}
     protocol = resolve(load_text(yaml.safe_dump(case, sort_keys=False), "matrix_text.yaml"))
     assert protocol.text is not None
     files: dict[str, str] = {}
     for emitter in emitters():
-        if emitter.name == "c":
-            with pytest.raises(Unsupported, match=r"^a message's own text with labels \(`text: \{named: "):
-                emitter.files(protocol)
-            continue
         emitted = emit(emitter, protocol)
+        if emitter.name == "c":
+            text_c_compiles(emitted, tmp_path)
+            continue
         assert emitter.verify is None or emitter.verify(protocol, emitted) == []
         files.update(emitted)
     docs = files["docs/matrix_text.md"]
@@ -2496,33 +2519,15 @@ def test_starts_by_direction_and_an_address_before_the_code_through_every_output
         resolve(load_text(yaml.safe_dump(refused, sort_keys=False), "matrix_text.yaml"))
 
 
-def test_labels_glued_to_their_values_through_every_output() -> None:
+def test_labels_glued_to_their_values_through_every_output(tmp_path: Path) -> None:
     """`text: {named: ""}` (G-code's `G1 X10.5 Y-3`) and with `separator: ""` too (Lynxmotion LSS's `D1800T1500`, the
-    first value labelled with the code): the C refuses them in one line (labels: it takes a message's own text without
-    them), the dissector reads them (tests/test_wireshark_text.py holds it to decode); the reference says how they are
+    first value labelled with the code): the C and the dissector read them (tests/test_c_text.py and
+    tests/test_wireshark_text.py hold them to Python); the reference says how they are
     written; random messages round trip and stream; what a frame could not tell apart is refused."""
     case = copy.deepcopy(TEXT_CASE)
-    case["commands"]["move"] = {
-        "code": "MV",
-        "response": {
-            "unsolicited": True,
-            "text": {"named": "", "separator": ""},
-            "fields": {
-                "at": {"label": "MV", "type": "integer"},
-                "time": {"label": "T", "type": "integer"},
-                "speed": {"label": "SD", "type": "decimal"},
-            },
-        },
-    }
-    case["commands"]["words"] = {
-        "code": "GW",
-        "response": {
-            "unsolicited": True,
-            "text": {"named": ""},
-            "fields": {"x": {"label": "X", "type": "decimal"}, "y": {"label": "Y", "type": "integer"}},
-        },
-    }
-    files = python_and_markdown(case, {"c": r"^a message's own text with labels \(`text: \{named: "})
+    case["commands"] |= {key: copy.deepcopy(LABELLED_COMMANDS[key]) for key in ("move", "words")}
+    files = python_and_markdown(case, {})
+    text_c_compiles({p: t for p, t in files.items() if p.startswith("matrix_text/matrix_text")}, tmp_path)
     assert "written as its label glued to its value" in files["docs/matrix_text.md"]
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:

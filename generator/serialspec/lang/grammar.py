@@ -780,8 +780,8 @@ TEXT_LAYOUT = Obj(
     },
     description="Text frames: the message's own text inside the frame, in place of the framing's separator (GRBL's "
     "status report `<Idle|MPos:1.000,2.000,3.000|FS:0,0>` beside plain `ok` and `error:20` lines); the stream parser, "
-    "checksum and line end stay the framing's. The C target takes one whose fields have no labels; it refuses labels "
-    "(`named`), and the Wireshark dissector any `text:`, saying so.",
+    "checksum and line end stay the framing's. Every target takes it, labels too (the C: a `has_<field>` flag per "
+    "labelled field, a repeat's too).",
 )
 
 MESSAGE = Obj(

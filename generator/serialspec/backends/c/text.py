@@ -30,7 +30,7 @@ from serialspec.backends.c.text_runtime import (
 )
 from serialspec.backends.common.text_frames import C_TAKES, refuse_text_frames
 from serialspec.checksums.base import NoCode
-from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextLayout, TextMessage, TextRepeat
 
 RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "E_FRAME", "E_CONTENT", "E_CAPACITY")
 
@@ -123,6 +123,8 @@ class TextC:
                 group = f"{p}_{mid(m)}_{ident(item.name)}_t"
                 inner = [line for f in item.fields for line in self.member(f)]
                 out.append("typedef struct {\n" + "\n".join(inner) + f"\n}} {group};")
+                if item.label:  # found by its label: absent where the frame leaves it out
+                    mems.append(f"    bool has_{ident(item.name)}; /* its label was sent */")
                 if item.count:
                     mems.append(f"    {group} {ident(item.name)}[{item.count}]; /* {comment(item.description)} */")
                 else:
@@ -299,35 +301,40 @@ const char *{p}_result_name(int result);
 
     # --- the source ------------------------------------------------------------------------------------------------
 
-    def read(self, f: TextField, lv: str) -> str:
-        """Decode statements of one field into the member `lv` (an lvalue path without the member name)."""
+    def read(self, f: TextField, lv: str, cursor: str = "c") -> str:
+        """Decode statements of the next field of `cursor` (a pointer) into the member `lv` (an lvalue path without
+        the member name)."""
+        return f"    {self.call('rest' if f.rest else 'next')}({cursor}, &s, &len);\n" + self.value(f, lv, cursor)
+
+    def value(self, f: TextField, lv: str, cursor: str = "c") -> str:
+        """Decode statements of one field's text, `cursor`->b[s, s + len), into the member `lv` (empty: absent)."""
         P, n = self.P, ident(f.name)
         target = f"{lv}{n}"
+        text = f"{cursor}->b + s, len"
         match f.kind:
             case "decimal":
-                call = f"{self.call('get_decimal')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_decimal')}({text}, &{target})"
             case "integer" if f.base == 16:
-                call = f"{self.call('get_hex_integer')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_hex_integer')}({text}, &{target})"
             case "integer":
-                call = f"{self.call('get_integer')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_integer')}({text}, &{target})"
             case "angle":
-                call = f"{self.call('get_angle')}(c->b + s, len, {f.width or 2}u, &{target})"
+                call = f"{self.call('get_angle')}({text}, {f.width or 2}u, &{target})"
             case "char":
-                call = f"{self.call('get_char')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_char')}({text}, &{target})"
             case "text":
-                call = f"{self.call('get_text')}(c->b + s, len, {target}, {P}_TEXT_MAX, &{target}_len)"
+                call = f"{self.call('get_text')}({text}, {target}, {P}_TEXT_MAX, &{target}_len)"
             case "time":
-                call = f"{self.call('get_time')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_time')}({text}, &{target})"
             case "date":
-                call = f"{self.call('get_date')}(c->b + s, len, &{target})"
+                call = f"{self.call('get_date')}({text}, &{target})"
             case _:
                 assert_never(f.kind)
         letters = ""
         if f.letters:
             allowed = " && ".join(f"{target} != '{_c_char(letter)}'" for _, letter in f.letters)
             letters = f"\n        if (r == {P}_OK && {allowed}) {{\n            r = {P}_E_CONTENT;\n        }}"
-        return f"""    {self.call("rest" if f.rest else "next")}(c, &s, &len);
-    {lv}has_{n} = len > 0u;
+        return f"""    {lv}has_{n} = len > 0u;
     if (len > 0u) {{
         r = {call};{letters}
         if (r != {P}_OK) {{
@@ -337,6 +344,8 @@ const char *{p}_result_name(int result);
 
     def decoder(self, m: TextMessage) -> str:
         p, P = self.p, self.P
+        if m.layout is not None and m.layout.labelled:
+            return self.labelled_decoder(m, m.layout)
         lines: list[str] = []
         at = 0
         for item in _sent(m):
@@ -373,6 +382,96 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
     (void)m;
 {used}
     return c->more ? {P}_E_LENGTH : {P}_OK; /* more fields than the message has */
+}}"""
+
+    def labelled_decoder(self, m: TextMessage, layout: TextLayout) -> str:
+        """A message's own text with labels (runtime/text.py _decode_labelled, _glued, _labelled_values): each part
+        found by its label, in any order (an unknown one, or one sent twice, P_E_CONTENT), a repeat's values split by
+        `list` (a wrong number of them P_E_LENGTH); an absent label leaves its field absent. The cursor holds the
+        text after the code (and what follows it); in a text with a start, from the code on: its part holds the value
+        labelled with the code where it holds `named` (GRBL's `Hold:0`); glued to its labels, from the code on where
+        a field is labelled with it (LSS's `D1800`, its value the code's)."""
+        p, P = self.p, self.P
+        items = _sent(m)
+        order = sorted(range(len(items)), key=lambda i: -len(items[i].label))  # the longest label first
+        labels = ", ".join(c_text(items[i].label) for i in order)
+        named = _byte(layout.named) if layout.named else "0u"
+        cases = []
+        for index, i in enumerate(order):
+            item = items[i]
+            if isinstance(item, TextField):
+                body = self.value(item, "m->")
+            else:
+                name, size = ident(item.name), len(item.fields)
+                wrong = f"values % {size}u != 0u || " if size > 1 else ""
+                wrong += f"values != {item.count * size}u" if item.count else f"values > {item.max_count * size}u"
+                count = "" if item.count else f"\n    m->{name}_count = (uint8_t)(values / {size}u);"
+                reads = "\n".join(self.read(f, f"m->{name}[g].", "(&v)") for f in item.fields)
+                body = f"""    for (g = s; g < s + len; g++) {{
+        values += c->b[g] == {_byte(layout.list)} ? 1u : 0u;
+    }}
+    if ({wrong}) {{
+        return {P}_E_LENGTH; /* not the repeat's number of values */
+    }}
+    m->has_{name} = true;{count}
+    v.b = c->b + s;
+    v.n = len;
+    v.pos = 0u;
+    v.more = 1;
+    v.sep = {_byte(layout.list)};
+    v.list = {_byte(layout.list)};
+    for (g = 0u; g < values / {size}u; g++) {{
+    {reads.replace(chr(10), chr(10) + "    ")}
+    }}"""
+            cases.append(
+                f"        case {index}u: /* {comment(item.label)}: {item.name} */\n"
+                + "\n".join("        " + line if line else line for line in body.split("\n"))
+                + "\n            break;"
+            )
+        head = ""
+        if layout.start:  # the code's own part: a value where it holds `named`, else the code alone
+            sep_ = _byte(layout.separator)
+            head = f"""    for (g = c->pos; g < c->n && c->b[g] != {sep_} && c->b[g] != {named}; g++) {{
+    }}
+    if (g >= c->n || c->b[g] != {named}) {{
+        {self.call("next")}(c, &s, &len); /* the code alone */
+    }}
+"""
+        self.call("pair")
+        sep = int(bool(layout.separator))
+        cursor = (
+            f"    {p}__cursor_t v; /* a repeat's values */\n" if any(isinstance(i, TextRepeat) for i in items) else ""
+        )
+        head_c = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
+        return f"""/* {head_c}, in its own text: its fields found by their labels. */
+static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
+{{
+    static const char *const labels[] = {{{labels}}};
+    uint8_t seen[{len(items)}];
+    size_t s = 0u, len = 0u, g = 0u, which = 0u, values = 1u;
+{cursor}    int r = {P}_OK;
+    (void)sent;
+    (void)g;
+    (void)values;
+    memset(seen, 0, sizeof(seen));
+    c->list = c->sep; /* a repeat's values are split by its list in its part */
+{head}    while (c->more) {{
+        r = {p}__pair(c, {named}, {sep}, labels, {len(items)}u, &which, &s, &len);
+        if (r != {P}_OK) {{
+            return r;
+        }}
+        if (seen[which]) {{
+            return {P}_E_CONTENT; /* a label sent twice */
+        }}
+        seen[which] = 1u;
+        values = 1u;
+        switch (which) {{
+{chr(10).join(cases)}
+        default:
+            break;
+        }}
+    }}
+    return {P}_OK;
 }}"""
 
     def check(self, f: TextField, lv: str, own: str = "", rest_own: str = "") -> str:
@@ -426,6 +525,14 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         layout, as C) as a part of its layout, after that separator where a part comes before it."""
         n = ident(f.name)
         v = f"{lv}{n}"
+        call = self.put_value(f, v)
+        before = f"{self.call('part')}(o, &first, {part})" if part else f"{self.call('put')}(o, {self.P}__SEPARATOR)"
+        if f.rest and not part:  # the separators in it are its own (p__trim)
+            before += ";\n    o->rest = o->n"
+        return f"    {before};\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+
+    def put_value(self, f: TextField, v: str) -> str:
+        """The call that writes the value of the member `v` as its text."""
         match f.kind:
             case "decimal":
                 call = f"{self.call('put_decimal')}(o, &{v}, {v}.width)"
@@ -445,10 +552,7 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
                 call = f"{self.call('put_date')}(o, &{v})"
             case _:
                 assert_never(f.kind)
-        before = f"{self.call('part')}(o, &first, {part})" if part else f"{self.call('put')}(o, {self.P}__SEPARATOR)"
-        if f.rest and not part:  # the separators in it are its own (p__trim)
-            before += ";\n    o->rest = o->n"
-        return f"    {before};\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+        return call
 
     def encoder(self, m: TextMessage) -> str:
         p, P = self.p, self.P
@@ -457,10 +561,10 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         layout = m.layout
         own, part, joined = "", "", ""
         if layout is not None:  # its own separator (a repeat's values joined by `list`) and characters
-            own = "".join(
-                sorted({layout.start, layout.end, layout.separator, layout.list, layout.after_code or ""} - {""})
-            )
-            part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
+            chars = {layout.start, layout.end, layout.separator, layout.named, layout.list, layout.after_code or ""}
+            own = "".join(sorted(chars - {""}))
+            if not layout.labelled:
+                part, joined = _byte(layout.separator), _byte(layout.list or layout.separator)
         rest_own = (
             "".join(sorted(set(own) - {layout.separator, layout.after_code or "", self.text.separator}))
             if layout
@@ -469,17 +573,23 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
         t = self.text
         if not self.marked() and t.checksum is not None and m.direction.value in t.checksum_directions:
             own, rest_own = own + t.marker, rest_own + t.marker  # its frames carry the checksum after the marker
+        labelled = layout is not None and layout.labelled  # written by labelled_writes
         for item in _sent(m):
             if isinstance(item, TextField):
                 checks.append(self.check(item, "m->", own, rest_own))
-                writes.append(self.write(item, "m->", part))
+                if not labelled:
+                    writes.append(self.write(item, "m->", part))
                 continue
             name = ident(item.name)
             groups = f"{item.count}u" if item.count else f"m->{name}_count"
+            if item.label:  # absent where its label is not sent: nothing to check
+                groups = f"(m->has_{name} ? {groups} : 0u)"
             if not item.count:
-                checks.append(f"    if (m->{name}_count > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
+                checks.append(f"    if ({groups} > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
             inner = "\n".join(self.check(f, f"m->{name}[g].", own) for f in item.fields).replace("\n", "\n    ")
             checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
+            if labelled:
+                continue
             inner = "\n".join(
                 self.write(f, f"m->{name}[g].", (f"g == 0u ? {part} : {joined}" if k == 0 else joined) if part else "")
                 for k, f in enumerate(item.fields)
@@ -487,7 +597,10 @@ static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
             writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
         head = f"{comment(m.title)} ({comment(m.code)}, {m.direction.value})"
         written = "\n".join(writes)
-        if layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text
+        if layout is not None and labelled:
+            written = self.labelled_writes(m, layout)
+            head += ", in its own text with labels"
+        elif layout is not None:  # runtime/text.py _encode_in: after the code, its fields only where they have text
             after = layout.follows_code
             written = (
                 f"    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);\n    fields = o->n;\n{written}\n"
@@ -514,6 +627,59 @@ static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
 {written}
     return {P}_OK;
 }}"""
+
+    def labelled_writes(self, m: TextMessage, layout: TextLayout) -> str:
+        """runtime/text.py _encode_in of a message whose fields have labels: the value labelled with the code right
+        after it, then what follows the code and each other field present as its label, `named` and its value (a
+        repeat's values joined by `list`), joined by the separator; none present: the code alone."""
+        items = _sent(m)
+        lines = []
+        for item in items:
+            if isinstance(item, TextField) and item.label == m.code:  # GRBL's `Hold:0`, LSS's `D1800`
+                v = f"m->{ident(item.name)}"
+                lines.append(
+                    f"    if (m->has_{ident(item.name)}) {{ /* the value labelled with the code, right after it */\n"
+                    f"        {self.call('put_text')}(o, {_c_string(layout.named)}, {len(layout.named)}u);\n"
+                    f"        {self.put_value(item, v)};\n    }}"
+                )
+        after = layout.follows_code
+        lines.append(f"    code = o->n;\n    {self.call('put_text')}(o, {_c_string(after)}, {len(after)}u);")
+        part = f"{self.call('part')}(o, &first, {_byte(layout.separator)})" if layout.separator else "first = 0"
+        for item in items:
+            name = ident(item.name)
+            if item.label == m.code:
+                continue
+            label = item.label + layout.named
+            present = (
+                f"m->has_{name}"
+                if isinstance(item, TextField) or item.count
+                else f"m->has_{name} && m->{name}_count > 0u"
+            )
+            head = f"        {part};\n        {self.call('put_text')}(o, {_c_string(label)}, {len(label)}u);\n"
+            if isinstance(item, TextField):
+                lines.append(f"    if ({present}) {{\n{head}        {self.put_value(item, f'm->{name}')};\n    }}")
+                continue
+            groups = f"{item.count}u" if item.count else f"m->{name}_count"
+            inner = []
+            for k, f in enumerate(item.fields):
+                between = f"{self.call('put')}(o, {_byte(layout.list)});"
+                if k == 0:
+                    between = f"if (g > 0u) {{\n                {between}\n            }}"
+                value = f"m->{name}[g].{ident(f.name)}"
+                inner.append(
+                    f"            {between}\n            if (m->{name}[g].has_{ident(f.name)}) {{\n"
+                    f"                {self.put_value(f, value)};\n            }}"
+                )
+            lines.append(
+                f"    if ({present}) {{\n{head}        for (g = 0u; g < {groups}; g++) {{\n"
+                + "\n".join(inner)
+                + "\n        }\n    }"
+            )
+        lines.append(
+            "    if (first) { /* no field but the code's own: the code alone */\n        o->n = code;\n    }\n"
+            f"    {self.call('put_text')}(o, {_c_string(layout.end)}, {len(layout.end)}u);"
+        )
+        return "\n".join(lines)
 
     def bare_decode(self, bare: list[TextMessage]) -> tuple[str, str, str, str]:
         """Replies of values alone (`values_only`: ODrive's `r vbus_voltage` answered `24.1`), read as the reply
@@ -657,6 +823,19 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
         for index, layout in enumerate(layouts):
             kinds = " || ".join(f"kind == {P}_{mid(m).upper()}" for m in t.messages if m.layout == layout)
             s, e = len(layout.start), len(layout.end)
+            code = f"        kind = {p}__lookup(t + talker, cut - talker, dir);\n"
+            fields = (
+                "        c.b = t + (cut < inner ? cut + 1u : inner);\n"
+                "        c.n = cut < inner ? inner - cut - 1u : 0u;\n"
+                "        c.pos = 0u;\n        c.more = cut < inner;\n"
+            )
+            if layout.named:  # the code up to `named`: its part may hold the value labelled with it (`Hold:0`)
+                code = (
+                    f"        for (k = talker; k < cut && t[k] != {_byte(layout.named)}; k++) {{\n        }}\n"
+                    f"        kind = {p}__lookup(t + talker, k - talker, dir);\n"
+                )
+                fields = "        c.b = t + talker;\n        c.n = inner - talker;\n"
+                fields += "        c.pos = 0u;\n        c.more = 1;\n"
             starts = f'{self.call("alone")}(frame + body, n, {_c_string(layout.start)}, {s}u, "", 0u, '
             ends = f"{_c_string(layout.end)}, {e}u, &at, &inner)"
             reads.append(f"""    if (!own && {starts}{ends} &&
@@ -668,20 +847,15 @@ static void {p}__answered({p}_parser_t *p, const {p}_msg_t *out)
         while (cut < inner && t[cut] != {_byte(layout.separator)}) {{
             cut++;
         }}
-        talker = cut < {t.talker}u ? cut : {t.talker}u;
+        talker = {f"cut < {t.talker}u ? cut : {t.talker}u" if t.talker else "0u"};
         for (k = 0u; k < talker; k++) {{
             out->talker[k] = (char)t[k];
         }}
         out->talker[talker] = '\\0';
-        kind = {p}__lookup(t + talker, cut - talker, dir);
-        if (kind == {P}_KIND_NONE || !({kinds})) {{
+{code}        if (kind == {P}_KIND_NONE || !({kinds})) {{
             return {P}_E_UNKNOWN; /* no message of this text */
         }}
-        c.b = t + (cut < inner ? cut + 1u : inner);
-        c.n = cut < inner ? inner - cut - 1u : 0u;
-        c.pos = 0u;
-        c.more = cut < inner;
-        c.sep = {_byte(layout.separator)};
+{fields}        c.sep = {_byte(layout.separator)};
         c.list = {_byte(layout.list or layout.separator)};
         seps = cut < inner ? 1u : 0u;
         for (k = 0u; k < c.n; k++) {{
@@ -736,7 +910,8 @@ static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
         for m in alone:
             layout = m.layout
             assert layout is not None
-            after = layout.follows_code
+            after = m.read_after_code
+            separator = _byte(layout.separator) if layout.separator else "0x00u"  # none: labels glued to numbers
             call = (
                 f"{self.call('alone')}(t, tn, {_c_string(m.code)}, {len(m.code)}u, {_c_string(after)}, {len(after)}u, "
                 f"{_c_string(layout.end)}, {len(layout.end)}u, &at, &inner)"
@@ -745,22 +920,24 @@ static int {p}__plain({p}_kind_t kind, {p}_direction_t dir)
                 f"        {'if' if not tries else '} else if'} (dir == {P}_{m.direction.name} &&\n"
                 f"            {call}) {{\n"
                 f"            kind = {P}_{mid(m).upper()};\n"
-                f"            c.sep = {_byte(layout.separator)};\n"
-                f"            c.list = {_byte(layout.list or layout.separator)};"
+                f"            c.sep = {separator};\n"
+                f"            c.list = {_byte(layout.list) if layout.list else separator};\n"
+                # glued to its labels, one of them the code: read from the code on (LSS's `D1800`)
+                f"            head = {len(m.code) if layout.glued and m.code_labelled else 0}u;"
             )
         read = f"""    if (!{p}__plain(kind, dir)) {{ /* found by its code alone, of `dir`: longest code first */
         const uint8_t *t = frame + body + {skip};
-        size_t tn = n - {skip}, at = 0u, inner = 0u;
+        size_t tn = n - {skip}, at = 0u, inner = 0u, head = 0u;
         int found = 1;
 {chr(10).join(tries)}
         }} else {{
             found = 0;
         }}
         if (found) {{ /* its fields, between its own separators */
-            c.b = t + at;
-            c.n = inner;
+            c.b = t + at - head;
+            c.n = inner + head;
             c.pos = 0u;
-            c.more = inner > 0u;
+            c.more = c.n > 0u;
             seps = inner > 0u ? 1u : 0u;
             for (i = 0u; i < inner; i++) {{
                 if (c.b[i] == c.sep || c.b[i] == c.list) {{
@@ -1303,6 +1480,72 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap);
 """
 
 
+def _labelled_json(p: str, m: TextMessage, layout: TextLayout, text: TextFrame) -> str:
+    """p_to_json's fields of a message whose fields have labels, from its text as encode writes it (its fields
+    present, in order, the one labelled with the code right after it): where each value is, then each field in
+    order, an absent one "" (a repeat: [])."""
+    items = _sent(m)
+    u = f"msg->u.{mid(m)}"
+    numbers = int(layout.glued and not layout.separator)  # values that end where a label begins
+    stop = _byte(layout.separator) if layout.separator else "0x00u"
+    lines = [
+        f"    for (c.pos = 0u; c.pos < {text.talker}u && msg->talker[c.pos] != '\\0'; c.pos++) {{\n    }}"
+        if text.talker
+        else "    c.pos = 0u;",
+        f"    {p}__j_over(&c, {'lead + ' if text.address else ''}{len(layout.start) + len(m.code)}u);",
+    ]
+    if layout.end:
+        lines.append(f"    c.n = len >= {len(layout.end)}u ? len - {len(layout.end)}u : 0u;")
+    lines.append("    c.pos = c.pos < c.n ? c.pos : c.n;")
+    # the code's own value first, then what follows the code, then the others in order
+    written = [i for i, f in enumerate(items) if f.label == m.code] + [-1]
+    written += [i for i, f in enumerate(items) if f.label != m.code]
+    for i in written:
+        if i < 0:
+            lines.append(f"    {p}__j_over(&c, {len(layout.follows_code)}u);")
+            continue
+        item = items[i]
+        own = item.label == m.code
+        skip = len(layout.named) if own else len(item.label) + len(layout.named)
+        lines.append(
+            f"    if ({u}.has_{ident(item.name)}) {{\n        {p}__j_over(&c, {skip}u);\n        at[{i}] = c.pos;\n"
+            f"        {p}__j_value(&c, {stop}, {numbers});\n        span[{i}] = c.pos - at[{i}];\n"
+            + ("" if own else f"        {p}__j_over(&c, {len(layout.separator)}u);\n")
+            + "    }"
+        )
+    first = text.address is None
+    if text.address is not None:  # its digits, first in the text
+        lines.append(f'    {p}__j_str(&j, "\\"{text.address.name}\\":");\n    {p}__j_text(&j, body, lead);')
+    for i, item in enumerate(items):
+        comma = "" if first else ","
+        first = False
+        if isinstance(item, TextField):
+            lines.append(
+                f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_text(&j, body + at[{i}], span[{i}]);'
+            )
+            continue
+        name = ident(item.name)
+        groups = f"{item.count}u" if item.count else f"{u}.{name}_count"
+        names = "\n".join(
+            f'            {p}__j_str(&j, "{"" if k == 0 else ","}\\"{f.name}\\":");\n            {p}__j_field(&j, &d);'
+            for k, f in enumerate(item.fields)
+        )
+        lines.append(
+            f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":[");\n'
+            f"    if ({u}.has_{name}) {{\n"
+            f"        d.b = body + at[{i}];\n        d.n = span[{i}];\n        d.pos = 0u;\n"
+            f"        d.sep = {_byte(layout.list)};\n        d.list = {_byte(layout.list)};\n"
+            f"        for (g = 0u; g < {groups}; g++) {{\n"
+            f'            {p}__j_str(&j, g > 0u ? ",{{" : "{{");\n{names}\n            {p}__j_str(&j, "}}");\n'
+            f"        }}\n    }}\n"
+            f'    {p}__j_str(&j, "]");'
+        )
+    decls = f"    size_t at[{len(items)}] = {{0u}}, span[{len(items)}] = {{0u}};\n"
+    if any(isinstance(i, TextRepeat) for i in items):
+        decls += f"    {p}__jcur_t d;\n"
+    return "{\n" + decls + "\n".join(lines) + "\n}"
+
+
 def json_source(protocol: Protocol, text: TextFrame) -> str:
     p, P = protocol.name, protocol.name.upper()
     grow = sum(
@@ -1345,7 +1588,9 @@ def json_source(protocol: Protocol, text: TextFrame) -> str:
                 f'    {p}__j_str(&j, "]");'
             )
         body = "\n".join(parts)
-        if m.layout is not None:  # its own layout: the fields after the talker, code and what follows the code
+        if m.layout is not None and m.layout.labelled:
+            body = _labelled_json(p, m, m.layout, text)
+        elif m.layout is not None:  # its own layout: the fields after the talker, code and what follows the code
             layout = m.layout
             after = layout.follows_code
             body = (
@@ -1375,6 +1620,43 @@ static void {p}__j_rest({p}__json_t *j, {p}__jcur_t *c)
 {{
     {p}__j_text(j, c->b + c->pos, c->n - c->pos);
     c->pos = c->n;
+}}
+
+"""
+    if any(m.layout is not None and m.layout.labelled for m in text.messages):
+        rest += f"""/* Past k characters (a label and what follows it), at most to the end. */
+static void {p}__j_over({p}__jcur_t *c, size_t k)
+{{
+    c->pos = c->n - c->pos > k ? c->pos + k : c->n;
+}}
+
+/* Past a labelled value: to `sep`, or (numbers) past the run of number characters. */
+static void {p}__j_value({p}__jcur_t *c, uint8_t sep, int numbers)
+{{
+    while (c->pos < c->n && (numbers ? (c->b[c->pos] >= 0x30u && c->b[c->pos] <= 0x39u) || c->b[c->pos] == 0x2Bu ||
+                                           c->b[c->pos] == 0x2Du || c->b[c->pos] == 0x2Eu
+                                     : c->b[c->pos] != sep)) {{
+        c->pos++;
+    }}
+}}
+
+"""
+    field = ""
+    if any(  # a field read in turn: of a message without labels (but an address or the rest of the line), a repeat's
+        isinstance(item, TextRepeat) or not (item.address or item.rest or (m.layout is not None and m.layout.labelled))
+        for m in text.messages
+        for item in m.fields
+    ):
+        field = f"""static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
+{{
+    size_t start = c->pos;
+    while (c->pos < c->n && c->b[c->pos] != c->sep && c->b[c->pos] != c->list) {{
+        c->pos++;
+    }}
+    {p}__j_text(j, c->b + start, c->pos - start);
+    if (c->pos < c->n) {{
+        c->pos++;
+    }}
 }}
 
 """
@@ -1451,19 +1733,7 @@ typedef struct {{
     uint8_t list;
 }} {p}__jcur_t;
 
-static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
-{{
-    size_t start = c->pos;
-    while (c->pos < c->n && c->b[c->pos] != c->sep && c->b[c->pos] != c->list) {{
-        c->pos++;
-    }}
-    {p}__j_text(j, c->b + start, c->pos - start);
-    if (c->pos < c->n) {{
-        c->pos++;
-    }}
-}}
-
-{rest}static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
+{field}{rest}static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
 {{
     char number[40];
 {talker_json}    (void)snprintf(number, sizeof(number), "{sent_lead}\\"sent\\":%d,\\"fields\\":{{", (int)msg->sent);

@@ -179,6 +179,61 @@ static void pfx__rest(pfx__cursor_t *c, size_t *start, size_t *len)
         (),
     ),
     Piece(
+        r"""/* The next labelled value of a message's own text (runtime/text.py _decode_labelled, _glued): the index
+ * of its label in labels[0..count) (the longest first) and its text [*start, *start + *len); PFX_E_CONTENT for a
+ * part with no label of them. named: the character between label and value (0: the label glued to it, the
+ * longest it begins with); sep 0: no separator, each value the run of number characters after its label (LSS's
+ * `D1800T1500`). */
+static int pfx__pair(pfx__cursor_t *c, uint8_t named, int sep, const char *const *labels, size_t count,
+                     size_t *which, size_t *start, size_t *len)
+{
+    size_t s = c->pos, n = c->n - c->pos, k = 0u, i;
+    if (sep) {
+        pfx__next(c, &s, &n);
+    }
+    if (named != 0u) {
+        while (k < n && c->b[s + k] != named) {
+            k++;
+        }
+        if (k == n) {
+            return PFX_E_CONTENT; /* no label */
+        }
+    }
+    for (i = 0u; i < count; i++) {
+        size_t m = 0u;
+        while (labels[i][m] != '\0' && m < n && c->b[s + m] == (uint8_t)labels[i][m]) {
+            m++;
+        }
+        if (labels[i][m] == '\0' && (named == 0u || m == k)) {
+            k = m;
+            break;
+        }
+    }
+    if (i == count) {
+        return PFX_E_CONTENT; /* an unknown label */
+    }
+    *which = i;
+    *start = s + k + (named != 0u ? 1u : 0u);
+    *len = s + n - *start;
+    if (!sep) { /* the number ends where a label begins */
+        for (k = *start; k < c->n; k++) {
+            uint8_t b = c->b[k];
+            if (!((b >= 0x30u && b <= 0x39u) || b == 0x2Bu || b == 0x2Du || b == 0x2Eu)) {
+                break;
+            }
+        }
+        *len = k - *start;
+        c->pos = k;
+        c->more = k < c->n;
+    }
+    return PFX_OK;
+}
+
+""",
+        "pair",
+        ("next",),
+    ),
+    Piece(
         "/* Digits d[0..n) as a number (at most 18 digits: PFX_E_CAPACITY beyond, "
         r"""a number an int64_t may not hold). */
 static int pfx__digits(const uint8_t *d, size_t n, int64_t *out)

@@ -8,12 +8,12 @@ from collections.abc import Collection
 from serialspec.backends import Unsupported
 from serialspec.lang.model import TextField, TextFrame
 
-# what of the list each target generates: the C everything but labelled message text, the Wireshark dissector all
+# what of the list each target generates: the C and the Wireshark dissector all of it
 C_TAKES = frozenset(
     {"lines", "decimal", "separated", "values_only", "high_end", "ends", "codes", "layouts", "rest", "one_way"}
-    | {"starts", "address"}
+    | {"starts", "address", "labels"}
 )
-WIRESHARK_TAKES = C_TAKES | {"labels"}
+WIRESHARK_TAKES = C_TAKES
 
 
 def refuse_text_frames(text: TextFrame, takes: Collection[str] = ()) -> None:

@@ -26,9 +26,7 @@ def _layout(m: TextMessage, layout: TextLayout, ids: dict[TextLayout, int]) -> d
     or glued to their values), a repeat's `list`, what follows the code (`after`), and its labels, the longest first
     (a glued value is found by the longest label its text starts with)."""
     labels = [item.label for item in m.fields if not (isinstance(item, TextField) and item.address)]
-    after = layout.follows_code
-    if layout.glued and m.code in labels:  # the value labelled with the code follows it (LSS's `D1800`)
-        after = ""
+    after = m.read_after_code  # nothing where the value labelled with the code follows it (LSS's `D1800`)
     return {
         "id": ids.setdefault(layout, len(ids) + 1),
         "start": layout.start,

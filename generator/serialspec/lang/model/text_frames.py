@@ -89,6 +89,19 @@ class TextMessage:
     layout: TextLayout | None = None  # its own text inside the frame (`text:`): GRBL's `<Idle|MPos:…>`
     values_only: bool = False  # a reply of its values alone, no code: read as the answer to the request before it
 
+    @property
+    def code_labelled(self) -> bool:
+        """Whether a field is labelled with the message's own code (GRBL's sub-state `Hold:0`, LSS's `D1800`): its
+        value is written right after the code."""
+        return self.layout is not None and self.layout.labelled and any(f.label == self.code for f in self.fields)
+
+    @property
+    def read_after_code(self) -> str:
+        """What a frame of it found by its code has between the code and its fields: nothing where its labels are
+        glued to their values and one is the code (the value right after it, LSS's `D1800`), else `follows_code`."""
+        assert self.layout is not None
+        return "" if self.layout.glued and self.code_labelled else self.layout.follows_code
+
 
 @frozen
 class TextExample:

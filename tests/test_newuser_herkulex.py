@@ -88,6 +88,8 @@ def test_every_command_by_the_manuals_rules(
         assert hx.decode(frame) == message
     with pytest.raises(ChecksumError):
         hx.decode(frame[:5] + bytes([frame[5] ^ 0x02]) + frame[6:], hx.Direction.RESPONSE)
+    with pytest.raises(ChecksumError):  # without a direction too (the README: ChecksumError for a bad checksum)
+        hx.decode(frame[:5] + bytes([frame[5] ^ 0x02]) + frame[6:])
 
 
 def test_the_client_drives_the_simulator(hx: ModuleType) -> None:

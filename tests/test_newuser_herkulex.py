@@ -8,7 +8,9 @@ generated simulator. tests/test_herkulex.py keeps the older subset spec and the 
 
 from __future__ import annotations
 
+import contextlib
 import importlib
+import io
 from functools import reduce
 from pathlib import Path
 from types import ModuleType
@@ -17,6 +19,7 @@ import pytest
 from conftest import examples, generate_and_import, simulated
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from serialspec.cli import main as serialspec_main
 from serialspec.runtime.errors import ChecksumError
 
 SPEC = Path(__file__).parent / "specs" / "herkulex_drs.yaml"
@@ -100,3 +103,21 @@ def test_the_client_drives_the_simulator(hx: ModuleType) -> None:
         assert servos.ram_read(0xFD, 53, 1).values == b"\x05"
         assert servos.ram_read(0xFD, 58, 2).values == (512).to_bytes(2, "little")
         assert servos.reboot(0xFD).status_error == 0
+
+
+def test_sim_of_a_spec_without_a_device_says_what_to_add(tmp_path: Path) -> None:
+    """The first spec a newcomer writes has no `device:`; `sim` said only that no simulator is generated."""
+    spec = tmp_path / "herkulex_drs.yaml"
+    spec.write_text(SPEC.read_text(encoding="utf-8").split("\ndevice:\n")[0] + "\n", encoding="utf-8")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert serialspec_main(["sim", str(spec)]) == 1
+    assert err.getvalue().splitlines() == [
+        f"serialspec sim: {spec} has no `device:` section, so no simulator is generated: add one"
+        " (`device: {}` answers each request with its response, every value 0 or its `default`;"
+        " the tutorial's step 4 describes a device)"
+    ]
+    spec.write_text(spec.read_text(encoding="utf-8") + "device: {}\n", encoding="utf-8")
+    from serialspec.lang import load_protocol
+
+    assert load_protocol(str(spec)).device is not None  # the hint's spec is a valid one

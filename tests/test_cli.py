@@ -285,6 +285,19 @@ def test_field_values_beside_fields_are_named(capsys: pytest.CaptureFixture[str]
     )
 
 
+def test_plot_given_a_spec_where_its_capture_goes_says_where_the_spec_goes(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """`serialspec plot mhz19b.yaml --field co2 ...`, the spec first as every other verb takes it, said "line 2:
+    'protocol' is not a hex byte" (found writing the MH-Z19B spec as a new user); plot takes its spec with --spec."""
+    out = str(tmp_path / "co2.png")
+    assert main(["plot", "specs/crsf.yaml", "--field", "co2", "--out", out]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec plot: specs/crsf.yaml is a spec, not a capture: give the capture (monitor --save, sim --tap) and"
+        " the spec with --spec (serialspec plot CAPTURE --spec specs/crsf.yaml --field NAME --out FILE)"
+    )
+
+
 def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pytest.CaptureFixture[str]) -> None:
     """`encode --json '{"command": "rotat"}'` said only "has no request 'rotat'", and a shared-header frame "give the
     direction" without naming the option (found following the README from the wheel)."""

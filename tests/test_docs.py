@@ -160,6 +160,39 @@ def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None
     assert errata.strip() and ("### " in errata or "None recorded" in errata)
 
 
+def test_an_example_calls_a_constant_a_selector_only_where_it_picks_the_message() -> None:
+    """Every constant field was shown as `(selector)`: MH-Z19B's reserved zeros, DYNAMIXEL CLEAR's magic key. A
+    sub-command's selector (RRC) and the first field of commands sharing a code (RTCM 3's number) still are."""
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.lang import load_protocol
+
+    dynamixel = emit_docs(load_protocol(str(ROOT / "specs" / "dynamixel_p2.yaml"), "dynamixel_p2.yaml"))
+    assert "| `44 58 4C 22` | key | 0x224c5844 (constant) |" in dynamixel
+    rrc = emit_docs(load_protocol(str(ROOT / "specs" / "hiwonder_rrc.yaml"), "hiwonder_rrc.yaml"))
+    assert "(selector)" in rrc and "(constant)" not in rrc
+    rtcm = emit_docs(load_protocol(str(ROOT / "tests" / "specs" / "rtcm3.yaml"), "rtcm3.yaml"))
+    assert "(selector)" in rtcm
+
+
+def test_a_field_of_whole_bytes_in_a_bit_width_shows_its_bytes_alone(tmp_path: Path) -> None:
+    """MH-Z19B's five reserved zeros as one `u40` showed `3..7 (bits 0..39 of 3..7)`; a narrower field still shows
+    its bits (found writing the MH-Z19B spec as a new user)."""
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.lang import load_protocol
+
+    spec = tmp_path / "five.yaml"
+    spec.write_text(
+        "protocol: five\ntitle: Five\nbyte_order: big\nserial: {baudrate: 9600}\nframing:\n  elements:\n"
+        "    start: {role: header, value: FF}\n    command: {role: command, type: u8}\n    data: {role: content}\n"
+        "commands:\n  read:\n    code: 0x86\n    request:\n      fields:\n"
+        "        reserved: {type: u40, const: 0}\n        high: u4\n        low: u4\n",
+        encoding="utf-8",
+    )
+    docs = emit_docs(load_protocol(str(spec), "five.yaml"))
+    assert "| 2..6 | reserved | u40 |" in docs
+    assert "| 7 (bits 4..7 of 7) | high | u4 |" in docs or "| 7 (bits 0..3 of 7) | high | u4 |" in docs
+
+
 @pytest.mark.parametrize("spec", [*sorted((ROOT / "specs").glob("*.yaml")), TINYLAMP], ids=lambda p: p.stem)
 def test_a_reference_has_no_empty_code_span_column_or_section(spec: Path, tmp_path: Path) -> None:
     """Empty byte fields rendered as a literal `` (6 places); a spec of one's own got an empty 中文 column, a stray

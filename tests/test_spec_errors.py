@@ -167,6 +167,22 @@ def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[s
     assert any(expected in line for line in lines), lines
 
 
+def test_a_key_yaml_reads_as_false_and_a_mistake_elsewhere_give_both_lines(tmp_path: Path) -> None:
+    """The loader's mistakes (`off:` read as false) came alone: the passes' (a comma ending a flow value, 20 lines
+    further) only showed once they were fixed, one run per kind of mistake. What the passes would say of the mapping
+    that lost the key (here nothing, but a required key dropped would) stays unsaid."""
+    text = MINIMAL.replace("{role: command, type: u8}", "{role: command, type: u8, description: a code, one byte}")
+    text += "enums:\n  on_off:\n    values: {off: 0, 'on': 160}\n"
+    lines = errors_of(tmp_path, text)
+    assert [line.split(": ", 1)[0] for line in lines] == ["tiny.yaml:8:66", "tiny.yaml:22:14"], lines
+    assert "unknown key 'one byte'" in lines[0] and "the key off reads as false in YAML" in lines[1], lines
+    dropped = MINIMAL.replace("    code: 1\n", "    code: 1\n    yes: 2\n").replace("title: Move", "off: Move")
+    assert [line.split(": ", 2)[2] for line in errors_of(tmp_path, dropped)] == [
+        "the key yes reads as true in YAML: quote it ('yes')",
+        "the key off reads as false in YAML: quote it ('off')",
+    ]
+
+
 def test_a_misspelt_role_is_one_line_not_one_more_per_key_of_the_role(tmp_path: Path) -> None:
     # `role: lenght` was said, then `counts` and `adds` were each said to belong to a length element
     text = MINIMAL.replace(

@@ -71,6 +71,11 @@ def run(args: argparse.Namespace) -> int:
         raise SerialspecError(f"--out {args.out}: give a .png or .svg file")
     if bool(args.capture) == bool(args.port):
         raise SerialspecError("give a capture file, or --port URL to plot live")
+    if args.capture and Path(args.capture).suffix.lower() in (".yaml", ".yml"):  # as the other verbs take a spec
+        raise SerialspecError(
+            f"{args.capture} is a spec, not a capture: give the capture (monitor --save, sim --tap) and the spec"
+            f" with --spec (serialspec plot CAPTURE --spec {args.capture} --field NAME --out FILE)"
+        )
     pyplot = _pyplot()  # before anything is read: a missing matplotlib is said at once
     if args.port:
         if not args.spec:

@@ -280,7 +280,7 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     from serialspec.lang.loader import decode_text, load_text
     from serialspec.lang.resolve import resolve
 
-    located = load_text(decode_text(raw, display), display)
+    located = load_text(decode_text(raw, display), display, keep_going=True)  # resolve reports its mistakes too
     protocol = resolve(located)
     files: dict[str, str] = {}
     targets: dict[str, str] = {}

@@ -108,7 +108,10 @@ def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     module = submodule(package, "simulator")
     if module is None or (protocol.text is None and protocol.device is None):
-        raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
+        raise SerialspecError(
+            f"{args.spec} has no `device:` section, so no simulator is generated: add one (`device: {{}}` answers each"
+            " request with its response, every value 0 or its `default`; the tutorial's step 4 describes a device)"
+        )
     simulator = _text_device(args, module) if protocol.text is not None else _bus(args, protocol, module)
     simulator.echo = args.echo
     if args.baudrate is not None and args.baudrate <= 0:

@@ -203,6 +203,8 @@ def markdown_where(offset: int, bits: int, shift: int, size: int) -> str:
     """The markdown reference's byte column of a member of a run starting at byte `offset`: its bytes and bits."""
     at, first, last = span(bits, shift, size)
     where = str(offset + first) if first == last else f"{offset + first}..{offset + last}"
+    if bits == 8 * size:  # the run's every bit (a u40 between byte-sized fields): its bytes say it all
+        return where
     which = f"bit {at}" if bits == 1 else f"bits {at}..{at + bits - 1}"
     run = str(offset) if size == 1 else f"{offset}..{offset + size - 1}"
     return f"{where} ({which} of {run})"

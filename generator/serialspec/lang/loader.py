@@ -31,6 +31,9 @@ class Located:
     data: Any
     marks: dict[Path, tuple[int, int]] = field(default_factory=dict)
     key_marks: dict[Path, tuple[int, int]] = field(default_factory=dict)
+    # `load_text(..., keep_going=True)`: the loader's mistakes in a document it could still read (a key dropped, a
+    # value left out), which `resolve` reports beside its own (but none at or around their paths)
+    problems: list[SpecError] = field(default_factory=list)
 
     def where(self, path: Path) -> tuple[int, int]:
         """The position of the value at path, or of its nearest located ancestor."""
@@ -78,7 +81,7 @@ _PLAIN_TAGS = frozenset({"tag:yaml.org,2002:map", "tag:yaml.org,2002:seq"})
 CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
 
-def load_file(path: str, display_name: str | None = None) -> Located:
+def load_file(path: str, display_name: str | None = None, *, keep_going: bool = False) -> Located:
     file = display_name or path
     try:
         raw = read_spec(path)
@@ -86,7 +89,7 @@ def load_file(path: str, display_name: str | None = None) -> Located:
         raise SpecErrors([SpecError(file, 1, 1, "", "is a folder, not a spec file")]) from None
     except OSError as exc:
         raise SpecErrors([SpecError(file, 1, 1, "", f"cannot read the spec: {exc.strerror or exc}")]) from None
-    return load_text(decode_text(raw, file), file)
+    return load_text(decode_text(raw, file), file, keep_going=keep_going)
 
 
 def decode_text(raw: bytes, file: str) -> str:
@@ -114,7 +117,9 @@ def _line_column(raw: bytes | str, offset: int) -> tuple[int, int]:
 
 
 @without_cycle_collection
-def load_text(text: str, file: str) -> Located:
+def load_text(text: str, file: str, *, keep_going: bool = False) -> Located:
+    """The document with the position of every value; raises SpecErrors for a mistake in it, unless `keep_going` and
+    the document is still a mapping: its mistakes are then `problems`, for `resolve` to report with its own."""
     located = Located(file, None)
     try:
         try:
@@ -142,8 +147,9 @@ def load_text(text: str, file: str) -> Located:
         raise SpecErrors([SpecError(file, 1, 1, "", "empty spec (expected a mapping with protocol, framing, ...)")])
     errors: list[SpecError] = []
     located.data = _Converter(located, errors, root).convert(root, ())
-    if errors:
+    if errors and not (keep_going and isinstance(located.data, dict)):
         raise SpecErrors(errors)
+    located.problems = errors
     return located
 
 

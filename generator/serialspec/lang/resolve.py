@@ -18,19 +18,35 @@ from serialspec.lang.passes.text import is_text
 
 def load_protocol(path: str, display_name: str | None = None) -> Protocol:
     """Load, validate and resolve one spec file; raises SpecErrors listing every mistake."""
-    located = load_file(path, display_name or os.path.relpath(path))
+    located = load_file(path, display_name or os.path.relpath(path), keep_going=True)
     return resolve(located)
+
+
+def _near(path: str, loaded: list[SpecError]) -> bool:
+    """Whether a pass's mistake at `path` lies at, inside or around a value the loader refused."""
+    return any(
+        path == p.path
+        or path.startswith((f"{p.path}.", f"{p.path}["))
+        or p.path.startswith((f"{path}.", f"{path}["))
+        or not path
+        or not p.path
+        for p in loaded
+    )
 
 
 @without_cycle_collection
 def resolve(located: Located) -> Protocol:
-    """Run every pass over a loaded spec; raises SpecErrors listing every problem they found."""
+    """Run every pass over a loaded spec; raises SpecErrors listing every problem they found, after the loader's
+    (`located.problems`: a key YAML reads as true, a duplicate key), whose values the passes never saw: what the passes
+    say at or around those paths (a mapping left without that key) is left out."""
     ctx = Context(located)
     problems: list[SpecError] = []
     for step in TEXT_PASSES if is_text(ctx.data) else PASSES:
         problems.extend(step(ctx).run())
         if not isinstance(ctx.data, dict):
             break  # not even a mapping: the structural check has said so, nothing else applies
+    if located.problems:
+        problems = [*located.problems, *(p for p in problems if not _near(p.path, located.problems))]
     if problems or ctx.framing is None or ctx.serial is None:
         raise SpecErrors(problems)
     data = ctx.data

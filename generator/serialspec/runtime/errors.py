@@ -116,15 +116,17 @@ def either_direction(decode: Callable[[Direction], Message], ambiguous: str) -> 
     from responses (a reply whose code only replies have); `ambiguous` is the error when both or neither decode."""
     found: list[Message] = []
     reasons: dict[str, str] = {}
+    kinds: set[type[DecodeError]] = set()
     for direction in Direction:
         try:
             found.append(decode(direction))
         except DecodeError as exc:
             reasons[direction.value] = str(exc)
+            kinds.add(type(exc))
     if len(found) == 1:
         return found[0]
     if found:
         raise DecodeError(ambiguous)
-    if len(set(reasons.values())) == 1:
-        raise DecodeError(reasons[Direction.REQUEST.value])
+    if len(set(reasons.values())) == 1:  # one reason, of one kind both ways: ChecksumError stays one
+        raise (kinds.pop() if len(kinds) == 1 else DecodeError)(reasons[Direction.REQUEST.value])
     raise DecodeError("neither a request ({request}) nor a response ({response})".format_map(reasons))

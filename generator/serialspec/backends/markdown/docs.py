@@ -683,7 +683,7 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
     rows: list[dict[str, str]] = []
     for e, part in zip(layout.elements, unwrapped.parts, strict=True):
         if e.kind == "content" and message is not None:
-            rows += content_rows(message.fields, example.fields, part, 0, len(part))
+            rows += content_rows(message.fields, example.fields, part, 0, len(part), picking(protocol, example))
             continue
         value: Any = example.fields.get(e.name, "")
         if e.kind == "command":
@@ -723,7 +723,9 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
     for e in layout.elements:
         size = content_size if e.role == "content" else (e.size or 0)
         if e.role == "content" and message is not None:
-            rows += content_rows(message.fields, example.fields, frame, offset, offset + size)
+            rows += content_rows(
+                message.fields, example.fields, frame, offset, offset + size, picking(protocol, example)
+            )
         else:
             value = example.fields.get(e.name, "")
             if e.role == "command":
@@ -743,16 +745,26 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
     return rows
 
 
+def picking(protocol: Protocol, example: Example) -> str:
+    """Which of an example's constant fields pick its message: `all` in a sub-command (its selector), `first` where
+    commands share its code (the first field, RTCM 3's message number), else `none` (a reserved or magic value)."""
+    if example.subcommand is not None:
+        return "all"
+    code = protocol.command(example.command).code
+    return "first" if sum(c.code == code for c in protocol.commands) > 1 else "none"
+
+
 def content_rows(
-    fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int, end: int
+    fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int, end: int, picks: str = "all"
 ) -> list[dict[str, str]]:
     rows = []
     offset = start
-    for f in fields:
+    for index, f in enumerate(fields):
         size = fixed_size(f)
         value: Any = values.get(f.name, "")
         if isinstance(f, Scalar) and f.const is not None:
-            value = f"{f.const:#04x} (selector)"
+            selects = picks == "all" or (picks == "first" and index == 0)
+            value = f"{f.const:#04x} ({'selector' if selects else 'constant'})"
         elif isinstance(f, Scalar) and f.derived:
             target = values.get(f.derived[1], [])
             value = (

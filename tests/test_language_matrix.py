@@ -1373,6 +1373,20 @@ CASES[FORMS] = Case(
 )
 
 
+# A frame value one layout carries and another does not (the Pololu protocol form's device number beside the compact
+# form, which has none): None in frames of the layout without it; a message giving it is sent in the layout that
+# carries it, one giving None in the other (the C refuses it: a struct's integer holds no None)
+PARTIAL = "frame: layouts, a frame value (a device number) one layout carries and the other not"
+CASES[PARTIAL] = copy.deepcopy(CASES[FORMS])
+_framed = CASES[PARTIAL].framing["layouts"]["framed"]["elements"]
+CASES[PARTIAL].framing["layouts"]["framed"]["elements"] = {
+    "start": _framed["start"],
+    "device": {"role": "address", "type": "u8", "range": [0, 127], "directions": ["request"]},
+    **{k: v for k, v in _framed.items() if k != "start"},
+}
+C_REFUSES[PARTIAL] = "a frame value that some alternative layout does not carry (device, requests)"
+
+
 # `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
 CASES["device: sends every an expression (a rate)"] = Case(
     {"v": "u16"},

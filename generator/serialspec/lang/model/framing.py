@@ -199,8 +199,11 @@ class Framing:
 
     @property
     def classic(self) -> bool:
-        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code."""
-        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
+        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code (not where
+        a frame value is in some layouts only: the frame engine's, which gives None for it in the others)."""
+        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts) and not any(
+            self.partial_values(direction) for direction in self.alternatives
+        )
 
 
 @frozen

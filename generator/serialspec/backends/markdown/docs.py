@@ -192,7 +192,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         size = f"{size_text(message.padded, message.padded, None)}, sent without its trailing zero bytes (at least 1)"
     rows = [
         Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
-        if e in layout.elements
+        if any(x.name == e.name for x in layout.elements)
         else _partial_row(protocol, message, e)
         for e in layout.value_elements
     ]
@@ -271,8 +271,11 @@ def _partial_row(protocol: Protocol, message: Message, element: FrameElement) ->
     """A frame value some alternative layout does not carry (the Pololu form's device number): where it sits in
     the layouts carrying it; None in the others, a message giving it sent in a layout that carries it."""
     alternatives = protocol.framing.alternatives[message.direction]
-    carrying = [layout for layout in alternatives if element in layout.elements]
-    where = "; ".join(f"{_value_offset(layout, element)} ({layout.name} frame)" for layout in carrying)
+    carrying = [layout for layout in alternatives if any(x.name == element.name for x in layout.elements)]
+    where = "; ".join(
+        f"{_value_offset(layout, layout.elements[layout.index(element.name)])} ({layout.name} frame)"
+        for layout in carrying
+    )
     others = ", ".join(layout.name for layout in alternatives if layout not in carrying)
     said = f"None in the {others} frame: a message giving it is sent in the {carrying[0].name} frame."
     description = f"{element.description} {said}" if element.description else said

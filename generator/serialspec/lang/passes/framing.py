@@ -145,6 +145,8 @@ class FramingPass(FieldResolver):
                         "carries it",
                     )
         values = tuple(union.values())
+        if all(tuple(e.name for e in layout.value_elements) == tuple(union) for layout in layouts):
+            return layouts  # the same values in every layout: each keeps its own elements
         return [replace(layout, value_elements=values) for layout in layouts]
 
     def seconds_or_characters(self, value: dict[str, Any], key: str, path: Path) -> float:

@@ -201,10 +201,13 @@ def list_value(
 
 def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[dict[str, Any]]:
     frame = protocol.layout(message).value_elements
+    partial = protocol.framing.partial_values(message.direction)  # None too: sent in a layout without it
     frame_values = st.fixed_dictionaries(
         {
             e.name: st.fixed_dictionaries({b.name: bit_values(b) for b in e.bits})
             if e.bits
+            else st.none() | st.integers(int(e.minimum), int(e.maximum))
+            if e.name in partial
             else st.integers(int(e.minimum), int(e.maximum))
             for e in frame
             if e.type is not None

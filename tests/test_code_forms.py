@@ -145,9 +145,19 @@ def does_not_fit(data: dict[str, Any]) -> None:
     elements(data, "pololu")["command"]["code"] = "code + 0x80"
 
 
+def two_device_numbers(data: dict[str, Any]) -> None:
+    """A frame value one layout carries and the other not is in the language (tests/test_newuser_maestro.py); one
+    name of two types is a mistake."""
+    elements(data, "pololu")["device"] = {"role": "address", "type": "u8", "directions": ["request"]}
+    compact = elements(data, "compact")
+    compact["device"] = {"role": "address", "type": "u16", "directions": ["request"]}
+    data["framing"]["layouts"]["compact"]["elements"] = {"command": compact.pop("command"), **compact}
+
+
 @pytest.mark.parametrize(
     ("change", "said"),
     [
+        (two_device_numbers, "frame value device must be the same role, type and range in every layout that carries"),
         (shared_code, "its code in layout pololu, 0x04 (code & 0x7F), is set_target's too: a frame could not tell"),
         (bare_code_as_a_header, "in layout compact (no header) starts aa, as layout pololu's header aa does"),
         (two_bare_layouts, "alternative request layouts must start with different headers (one layout without"),

@@ -1373,6 +1373,21 @@ CASES[FORMS] = Case(
 )
 
 
+# A frame value one layout carries and another does not (the Pololu protocol form's device number beside the compact
+# form, which has none; here in replies too): None in frames of the layout without it; a message giving it is sent
+# in the layout that carries it, one giving None in the other; the simulator answers a request without it without
+# it (the C refuses it: a struct's integer holds no None)
+PARTIAL = "frame: layouts, a frame value (a device number) one layout carries and the other not"
+CASES[PARTIAL] = copy.deepcopy(CASES[FORMS])
+_framed = CASES[PARTIAL].framing["layouts"]["framed"]["elements"]
+CASES[PARTIAL].framing["layouts"]["framed"]["elements"] = {
+    "start": _framed["start"],
+    "device": {"role": "address", "type": "u8", "range": [0, 127]},
+    **{k: v for k, v in _framed.items() if k != "start"},
+}
+C_REFUSES[PARTIAL] = "a frame value that some alternative layout does not carry (device, requests)"
+
+
 # `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
 CASES["device: sends every an expression (a rate)"] = Case(
     {"v": "u16"},
@@ -1877,10 +1892,15 @@ def client_against_simulator(g: Generated) -> None:
     path = simulator.start()
     try:
         with Bus(path, client_module.BINDING, timeout=1.0) as bus:
+            # an address some layout does not carry: None too (a request in the form without it, answered so)
+            partial = g.protocol.framing.partial_values(request.direction)
+            ids = [device, None] if any(e.name in partial for e in addresses) else [device]
             for fields in st_examples(message_fields(g.protocol, request), 3):
-                fields = {**fields, **{e.name: device for e in addresses}}
-                reply = bus.request(message_class(g, request).from_fields(fields), message_class(g, response))
-                assert type(reply) is message_class(g, response)
+                for given in ids:
+                    fields = {**fields, **{e.name: given for e in addresses}}
+                    reply = bus.request(message_class(g, request).from_fields(fields), message_class(g, response))
+                    assert type(reply) is message_class(g, response)
+                    assert given is not None or all(getattr(reply, e.name, None) is None for e in addresses), reply
         asking = [m for m in g.protocol.messages() if m.asks_in]
         if asking:  # the generated method of a request that asks for probe's reply by probe's code
             client_class = next(v for k, v in vars(client_module).items() if k.endswith("Client") and k != "Client")

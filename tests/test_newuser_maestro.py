@@ -4,8 +4,8 @@ transfers, `maestro` is unrelated, `pololu-maestro` does not exist), so the peer
 Serial Servo Commands): its printed bytes are our golden frames, and a raw pyserial session sending the guide's
 bytes drives `serialspec sim`, as does our client. A 14-bit value sent as two 7-bit bytes is one field
 (`encoding: seven_bit`). The Pololu protocol form of the same commands (0xAA, device number, command with bit 7
-cleared) is a strict xfail: its command code and headerless layout are in the language (tests/test_code_forms.py),
-its device number, which the compact form does not carry, is not. Replies without a code, of different sizes, in a plain
+cleared) is a layout beside the compact one: its device number, which the compact form does not carry, is None in
+a compact frame's message. Replies without a code, of different sizes, in a plain
 `framing.elements` spec are taken by the stream parser as the reply awaited (a bug once; the spec names one layout
 from every command, which works too)."""
 
@@ -182,21 +182,56 @@ commands:
     code: 0x84
     request:
       fields: {channel: u8, target_low: u8, target_high: u8}
+  get_position:
+    code: 0x90
+    request:
+      fields: {channel: u8}
+    response:
+      fields: {position: u16}
+device:
+  reply: {position: 6000}
 """
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="language gap: the Pololu protocol form sends the same commands after 0xAA and a device number with bit 7 "
-    'of the command cleared (AA 0C 04 02 70 2E for 84 02 70 2E). The command element\'s `code: "code & 0x7F"` and a '
-    "headerless layout beside one with a header are in the language now (tests/test_code_forms.py reads both forms "
-    "without the device number); what is left is a frame value (the device number) that one layout carries and the "
-    "other does not: the loader says `alternative layouts must carry the same address/status`",
-)
 def test_the_pololu_protocol_form(tmp_path: Path) -> None:
+    """The guide's Pololu protocol (a language gap once): AA, the device number, the command with bit 7 cleared,
+    beside the compact form, which carries no device number. A message holds `device` None in the compact form;
+    encode sends the layout carrying what the message gives (a device number: the Pololu form); the client sends
+    the form of the device number it is given (None: the compact one), the sim answers a Pololu frame of its own
+    number only and every compact frame; the C refuses the spec in one line (a struct's integer holds no None)."""
+    import serial
+    from serialspec.backends import Unsupported
+
     path = tmp_path / "maestro_pololu.yaml"
     path.write_text(POLOLU_FORM, "utf-8")
-    load_protocol(path)
     module = generate_and_import(path, tmp_path / "out", "maestro_pololu")
-    message = module.decode(bytes.fromhex("aa 0c 04 02 70 2e"), module.Direction.REQUEST)
-    assert (message.channel, message.target_low, message.target_high) == (2, 0x70, 0x2E)
+    request = module.Direction.REQUEST
+    pololu = module.SetTargetRequest(device=12, channel=2, target_low=0x70, target_high=0x2E)
+    compact = module.SetTargetRequest(channel=2, target_low=0x70, target_high=0x2E)
+    assert module.decode(bytes.fromhex("aa 0c 04 02 70 2e"), request) == pololu  # the guide's example
+    assert module.decode(bytes.fromhex("84 02 70 2e"), request) == compact
+    assert compact.device is None
+    assert module.encode(pololu) == bytes.fromhex("aa 0c 04 02 70 2e")
+    assert module.encode(compact) == bytes.fromhex("84 02 70 2e")
+    assert module.SetTargetRequest.from_fields(pololu.to_fields()) == pololu
+    assert module.SetTargetRequest.from_fields(compact.to_fields()) == compact
+    with pytest.raises(RangeError, match=r"device = 128 is outside its range 0\.\.127"):
+        module.encode(module.SetTargetRequest(device=128, channel=2, target_low=0, target_high=0))
+    parser = module.StreamParser(request)
+    assert parser.feed(bytes.fromhex("aa 0c 04 02 70 2e 84 02 70 2e aa 0c")) == [pololu, compact]
+    assert parser.feed(bytes.fromhex("04 02 70 2e")) == [pololu]
+    with pytest.raises(Unsupported, match=r"^a frame value that some alternative layout does not carry \(device"):
+        c_files(load_protocol(path))
+    simulator = importlib.import_module("maestro_pololu.simulator").MaestroPololuSimulator(ids=[12])
+    client_class = importlib.import_module("maestro_pololu.client").MaestroPololuClient
+    try:
+        port_path = simulator.start()
+        with serial.Serial(port_path, 9600, timeout=0.5) as port:
+            port.write(bytes.fromhex("aa 0d 10 02 aa 0c 10 03 90 04"))  # device 13's (silence), 12's, compact
+            assert port.read(6) == bytes.fromhex("70 17 70 17")
+        with client_class(port_path, timeout=5) as maestro:
+            maestro.set_target(12, 2, 0x70, 0x2E)
+            assert maestro.get_position(12, 2) == 6000
+            assert maestro.get_position(None, 2) == 6000
+    finally:
+        simulator.close()

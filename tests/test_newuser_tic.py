@@ -5,8 +5,8 @@ and quick command decode and re-encode byte for byte, and its Get Variable reads
 A 32-bit value is sent as five data bytes (a byte of the four bytes' bit 7s, then their low 7 bits); the language
 has no encoding for that, so the spec spells the five bytes as fields (`msbs` with bit fields, `data0..data3`) and
 the test joins them: a strict xfail names the gap (one `i32` field with such an encoding). The Pololu protocol form
-(0xAA, device number, command with bit 7 cleared; ticlib's `device_number=`) is the gap
-tests/test_newuser_maestro.py names: a frame value (the device number) in one layout only."""
+(0xAA, device number, command with bit 7 cleared; ticlib's `device_number=`) is a layout beside the compact one, its
+device number None in a compact frame's message (as tests/test_newuser_maestro.py)."""
 
 from __future__ import annotations
 
@@ -139,25 +139,37 @@ def test_a_32_bit_target_as_one_field(tmp_path: Path) -> None:
 POLOLU_FORM = MAESTRO_FORMS[MAESTRO_FORMS.index("    pololu:") : MAESTRO_FORMS.index("commands:")]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=DecodeError,
-    reason="language gap (as tests/test_newuser_maestro.py): the Pololu protocol form (AA, device number, command "
-    "& 0x7F) beside the compact form. Replies without a code need layouts chosen by command (`layout:`), and a "
-    "command names ONE layout, so the same command cannot be sent in either: decode says `code 0xe0 is not sent "
-    "in layout 'pololu'`; without `layout:` the loader refuses a device number that one layout carries and the "
-    "other does not (`alternative layouts must carry the same address/status`)",
-)
 def test_the_pololu_protocol_form(tmp_path: Path) -> None:
+    """ticlib's `device_number=` (a language gap once): the Pololu form (AA, device number, command & 0x7F) beside
+    the compact form, every command sent in either (no `layout:`: the layouts are told apart by their header, the
+    code-less replies read as the reply awaited). ticlib's frames of device 14 and of none decode and encode back;
+    ticlib reads the sim in either form; the client sends the form of the device number it is given."""
+    import serial
+
     text = SPEC.read_text("utf-8").replace(
         "        content: {role: content}\n", "        content: {role: content}\n" + POLOLU_FORM, 1
     )
+    text = text.replace("    layout: compact\n", "").replace(", layout: compact", "")
     path = tmp_path / "tic.yaml"
     path.write_text(text.replace("protocol: tic", "protocol: tic_pololu"), "utf-8")
-    load_protocol(path)
     module = generate_and_import(path, tmp_path / "out", "tic_pololu")
-    golden = written("set_target_position", 100, device_number=14)  # AA 0E 60 00 64 00 00 00
-    assert module.decode(golden, module.Direction.REQUEST).device == 14
+    for device in (14, None):
+        golden = written("set_target_position", 100, device_number=device)  # AA 0E 60 00 64 00 00 00 for 14
+        message = module.decode(golden, module.Direction.REQUEST)
+        assert message == module.SetTargetPositionRequest.from_fields(split(100) | {"device": device})
+        assert module.encode(message) == golden
+        assert module.encode(module.EnergizeRequest(device=device)) == written("energize", device_number=device)
+    simulator = importlib.import_module("tic_pololu.simulator").TicPololuSimulator(ids=[14])
+    try:
+        port_path = simulator.start()
+        with serial.Serial(port_path, 9600, timeout=5) as port:
+            assert ticlib.TicSerial(port, device_number=14).get_current_position() == -1234567
+            assert ticlib.TicSerial(port).get_vin_voltage() == 12000
+        with importlib.import_module("tic_pololu.client").TicPololuClient(port_path, timeout=5) as client:
+            assert client.get_variable(14, "current_position") == -1234567
+            assert client.get_variable_raw(None, 0x33, 2) == (12000).to_bytes(2, "little")
+    finally:
+        simulator.close()
 
 
 def test_a_raw_read_is_sized_by_its_request(tic: ModuleType) -> None:

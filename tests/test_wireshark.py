@@ -180,8 +180,11 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
     message = message_of(protocol, direction, command, subcommand)
     prefix = ".".join(p for p in (name, command, subcommand, direction) if p)
     fields: dict[str, Any] = {}
+    partial = protocol.framing.partial_values(message.direction)
     for element in protocol.layout(message).value_elements:  # its own layout's (layouts chosen by command)
-        if element.bits:
+        if element.name in partial and not children(tree, f"{name}.frame.{element.name}"):
+            fields[element.name] = None  # a frame value its frame's layout does not carry (the compact form's)
+        elif element.bits:
             item = child(tree, f"{name}.frame.{element.name}")
             fields[element.name] = {
                 b.name: int(child(item, f"{name}.frame.{element.name}.{b.name}").get("show") or 0) for b in element.bits

@@ -1231,7 +1231,9 @@ FRAME_ELEMENT = Obj(
             "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
             "byte), a frame-level value (address, command, status, or a plain `value` every message carries: a "
             "sequence number, a flags byte), the length, the content, a checksum, or `optional` bytes that are "
-            "sent only when `present_if` holds (MAVLink v2's signature after the CRC).",
+            "sent only when `present_if` holds (MAVLink v2's signature after the CRC). A frame value in some "
+            "alternative layouts only (the Pololu form's device number) is None in messages of the others (see "
+            "`framing.layouts`).",
             choices=(
                 "header",
                 "trailer",
@@ -1556,7 +1558,15 @@ FRAMING = Obj(
             " there. The Pololu Maestro's two forms of the same commands: `compact: {elements: {command: {role: "
             "command}, content: {role: content}}}` (84 02 70 2E) and `pololu: {elements: {start: {role: header, "
             'value: AA}, command: {role: command, code: "code & 0x7F"}, content: {role: content}}}` (AA 04 02 70 '
-            "2E): both decode to Set Target, a frame starting AA is the Pololu form (no command code is AA).",
+            "2E): both decode to Set Target, a frame starting AA is the Pololu form (no command code is AA). "
+            "Layouts told apart by their header may carry different frame values (address, status, value "
+            "elements; one name is one role, type and range wherever it is): every message of the direction "
+            "carries each of them, None in a frame whose layout has no such element, and is sent in the layout "
+            "carrying exactly the values it gives (the Pololu form's `device: {role: address, type: u8, range: "
+            "[0, 127]}` after AA: `device=12` sends AA 0C 04 02 70 2E, `device=None` the compact 84 02 70 2E; "
+            "the client takes None for the device number; the simulator answers a frame without it as its first "
+            "device, in a form without it where replies carry it too; the C target refuses such a spec, its "
+            "structs' integers holding no None).",
         ),
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),

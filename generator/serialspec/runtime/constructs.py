@@ -161,9 +161,9 @@ class TrailingZeros(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
 class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """A whole frame of any layout (stuffing, lengths and checksums anywhere), by the runtime's frame engine.
 
-    Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements), `content` and
-    `extras` (the optional elements sent, by name); builds from the same keys. Construct has no byte stuffing, so
-    frames that are not of the classic shape use this.
+    Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements, None for one its
+    layout does not carry), `content` and `extras` (the optional elements sent, by name); builds from the same keys.
+    Construct has no byte stuffing, so frames that are not of the classic shape use this.
 
     Replies read with the request they answer (layouts chosen by command, a checksum over request bytes) parse
     with `layout=` (the layout's name) and `request=` (the request's frame) given: `RESPONSE_FRAME.parse(frame,
@@ -185,7 +185,7 @@ class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     def _decode(self, obj: bytes, context: Any, path: Any) -> Container:  # type: ignore[type-arg, unused-ignore]
         layout = self._layout(context.get("layout"))
         if layout is not None:
-            unwrapped = layout.unwrap(bytes(obj), self._asked(context))
+            unwrapped = self.codec.spread(layout.unwrap(bytes(obj), self._asked(context)))
         else:
             unwrapped = self.codec.unwrap(bytes(obj), None, self._asked(context))
         return Container(

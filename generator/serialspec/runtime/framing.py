@@ -741,13 +741,17 @@ class FrameCodec:
         replies: dict[Any, int] | None = None,
         refusals: dict[str, tuple[str, ...]] | None = None,
         error_status: tuple[str, int] | None = None,
+        partial: bool = False,
     ) -> None:
         """`replies`: frames that carry no code, in layouts chosen by command: each reply class's layout (by index),
         read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
         three keyed by the class's name, so the construct structs hold them without the message classes).
         `refusals`: with `replies`, reply class -> the classes of the replies that may refuse its request instead
         (`refused_by`), each read in its own layout when the frame is not the reply awaited (BNO055: `EE status`
-        for a read answered by `BB length data`)."""
+        for a read answered by `BB length data`). `partial`: layouts told apart by their header carry different
+        frame values (the Pololu form's device number beside the compact form): values are the direction's, in
+        order of first appearance, None for one a frame's layout does not carry; a message is sent in the layout
+        carrying exactly the values it gives."""
         self.layouts = tuple(layouts)
         self.by_header = tuple(sorted(self.layouts, key=lambda each: not each.header))  # the headerless one last
         # the plain layouts the stream parser sizes frames in (a layout with optional elements: its variants), and
@@ -763,6 +767,13 @@ class FrameCodec:
         self._trailing_cache: dict[int, _TrailingCodes | None] = {}  # by id() of a layout of self.variants
         # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
         self.sizers = tuple(self._sizer(layout) for layout in self.variants)
+        names = [tuple(layout.elements[i].name for i in layout.values) for layout in self.layouts]
+        self.value_names = tuple(dict.fromkeys(name for each in names for name in each))
+        self._carried = {
+            id(layout): tuple(self.value_names.index(name) for name in own)
+            for layout, own in zip(self.layouts, names, strict=True)
+        }
+        self.partial = partial
 
     @property
     def requests(self) -> bool:
@@ -779,20 +790,43 @@ class FrameCodec:
         extras: Mapping[str, bytes | None] | None = None,
     ) -> bytes:
         """The frame in the first layout that can hold it; `layout`: in that one (layouts chosen by command);
-        `extras`: the optional elements' bytes by name."""
-        if layout is not None:
-            return self.layouts[layout].wrap(content, code, values, request, extras)
+        `extras`: the optional elements' bytes by name. With `partial` values, a layout carrying exactly the values
+        given (not None)."""
+        given = {i for i, value in enumerate(values) if value is not None} if self.partial else set()
+        if layout is not None and not (self.partial and set(self._carried[id(self.layouts[layout])]) != given):
+            return self.layouts[layout].wrap(content, code, self._own(self.layouts[layout], values), request, extras)
         problem: EncodeError | None = None
         for candidate in self.layouts:
             if (candidate.codes is not None and code not in candidate.codes) or candidate.error:
                 continue  # (an error header's layout: only for the error reply, sent in it by its index)
+            if self.partial and set(self._carried[id(candidate)]) != given:
+                continue  # the layout carrying exactly the frame values given
             try:
-                return candidate.wrap(content, code, values, request, extras)
+                return candidate.wrap(content, code, self._own(candidate, values), request, extras)
             except EncodeError as exc:
                 problem = exc
+        if problem is None and self.partial:
+            shown = ", ".join(name for i, name in enumerate(self.value_names) if i in given) or "no frame value"
+            raise EncodeError(f"no layout sends code {code} with {shown} given")
         if problem is None:
             raise EncodeError(f"no layout sends code {code}")
         raise problem
+
+    def _own(self, layout: Layout, values: tuple[int, ...]) -> tuple[int, ...]:
+        """A layout's own frame values of the direction's (those it carries)."""
+        if not self.partial:
+            return values
+        return tuple(values[i] for i in self._carried[id(layout)])
+
+    def spread(self, unwrapped: Unwrapped) -> Unwrapped:
+        """A frame's values as the direction's: None for those its layout does not carry."""
+        if not self.partial:
+            return unwrapped
+        values: list[int | None] = [None] * len(self.value_names)
+        layout = self.layouts[self._origin[id(unwrapped.layout)]]  # (a variant's: its layout's)
+        for i, value in zip(self._carried[id(layout)], unwrapped.values, strict=True):
+            values[i] = value
+        return replace(unwrapped, values=tuple(values))  # type: ignore[arg-type]
 
     def layout_of(self, frame: bytes) -> Layout:
         """The layout whose header the frame starts with; the one headerless layout beside them takes the rest."""
@@ -820,7 +854,11 @@ class FrameCodec:
 
     def unwrap(self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None) -> Unwrapped:
         """Check a frame and take it apart: in the layout its header names, in the layout of its code (layouts
-        chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class)."""
+        chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class); its
+        values those of the direction (None for one its layout does not carry)."""
+        return self.spread(self._unwrap(frame, expect, request))
+
+    def _unwrap(self, frame: bytes, expect: Any, request: Mapping[str, bytes] | None) -> Unwrapped:
         if self.replies:
             if expect is None and len(self.layouts) > 1:
                 raise DecodeError(

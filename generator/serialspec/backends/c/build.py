@@ -13,7 +13,7 @@ from serialspec.backends.c.files import header, json_header, json_source, source
 from serialspec.backends.c.optional import expanded
 from serialspec.backends.c.readme import readme
 from serialspec.backends.c.vectors import check_vectors, vectors_header
-from serialspec.backends.common.frames import refuse_code_forms
+from serialspec.backends.common.frames import refuse_code_forms, refuse_partial_values
 from serialspec.lang.model import Protocol
 
 # The names a header defines: its macros, and the constants of its enums (`enum { P_MODE_SLOW = 0, P_MODE_FAST }`)
@@ -50,6 +50,7 @@ def _files(protocol: Protocol) -> dict[str, str]:
         return text.files(protocol, protocol.text)
     refuse_unsupported(protocol)
     refuse_code_forms(protocol, length_byte.applies(protocol))  # (emit.py: length_byte imports it)
+    refuse_partial_values(protocol)
 
     spec = protocol
     protocol, variants = expanded(spec)  # optional elements: each layout's plain variants in its place

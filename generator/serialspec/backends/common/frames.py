@@ -155,6 +155,18 @@ def refuse_code_forms(protocol: Protocol, length_byte: bool) -> None:
                 )
 
 
+def refuse_partial_values(protocol: Protocol) -> None:
+    """Unsupported for a frame value that some alternative layout does not carry (the Pololu form's device number
+    beside the compact form): a message holds None for it there, which a C struct's integer cannot."""
+    for direction in protocol.framing.alternatives:
+        partial = sorted(protocol.framing.partial_values(direction))
+        if partial:
+            raise Unsupported(
+                f"a frame value that some alternative layout does not carry ({', '.join(partial)}, "
+                f"{direction.value}s): None in the others"
+            )
+
+
 def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:
     """The optional elements (`present_if`) of a direction's layouts, each once, in element order: every message of
     the direction carries their bytes, or None, after its other fields."""

@@ -192,6 +192,8 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         size = f"{size_text(message.padded, message.padded, None)}, sent without its trailing zero bytes (at least 1)"
     rows = [
         Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
+        if any(x.name == e.name for x in layout.elements)
+        else _partial_row(protocol, message, e)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -263,6 +265,21 @@ def picked_text(lead: Discriminator, message: Message) -> str:
     value, bits = next((v, b) for v, b, m in lead.picks if m.key == message.key)
     shown = f"{value:#x}" if len({b for _, b, _ in lead.picks}) > 1 else str(value)
     return f"chosen by its {message.fields[0].name} ({shown}, the content's first {bits} bits)"
+
+
+def _partial_row(protocol: Protocol, message: Message, element: FrameElement) -> Row:
+    """A frame value some alternative layout does not carry (the Pololu form's device number): where it sits in
+    the layouts carrying it; None in the others, a message giving it sent in a layout that carries it."""
+    alternatives = protocol.framing.alternatives[message.direction]
+    carrying = [layout for layout in alternatives if any(x.name == element.name for x in layout.elements)]
+    where = "; ".join(
+        f"{_value_offset(layout, layout.elements[layout.index(element.name)])} ({layout.name} frame)"
+        for layout in carrying
+    )
+    others = ", ".join(layout.name for layout in alternatives if layout not in carrying)
+    said = f"None in the {others} frame: a message giving it is sent in the {carrying[0].name} frame."
+    description = f"{element.description} {said}" if element.description else said
+    return Row(where, element.name, element.type.name if element.type else "", "", "", description)
 
 
 def _value_offset(layout: FrameLayout, element: FrameElement) -> str:

@@ -423,9 +423,13 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 required = True
         pairs = []
         singles = []
+        partial = protocol.framing.partial_values(Direction.REQUEST)
         for f in fields:
             if f.name in sequences:
                 continue  # the client fills it in
+            if f.name in partial:  # a frame value some layout lacks (a device number): None sends a frame without it
+                params.append(f"{f.name}: {annotation(f)} | None")
+                continue
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
             if isinstance(f, Scalar) and f.bits and defaults.get(f.name, "REQUIRED") != "REQUIRED":

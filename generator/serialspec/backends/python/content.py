@@ -302,12 +302,15 @@ class PackageCode:
             elements.append(replace(element, minimum=0, maximum=top, flags=None))
         return [element_scalar(element) for element in elements]
 
-    def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
+    def attributes(
+        self, fields: list[SpecField], defaults: bool = True, partial: frozenset[str] = frozenset()
+    ) -> list[Attribute]:
         # Defaults only on a trailing run of fields that all have one: classes stay positional. A field with a default
         # before fields without one (a reserved byte, LX-16A's mode write; a value made of bit fields that are all
         # constants or defaults, a sync byte, as its bits class's) has it wherever it is; the fields after it without
         # one get REQUIRED, which __new__ refuses (positional calls keep working).
         given = {f.name: field_default(f) for f in fields} if defaults else {}
+        given |= dict.fromkeys(partial, "None")  # a frame value some layout does not carry: None there
         trailing: set[str] = set()
         for f in reversed(fields):
             if not given.get(f.name):
@@ -317,15 +320,14 @@ class PackageCode:
         after_default = False
         for f in fields:
             default = given.get(f.name, "")
+            shown = f"{annotation(f)} | None" if f.name in partial else annotation(f)
             if f.name in trailing:
-                attributes.append(Attribute(f.name, annotation(f), doc_line(f), default))
+                attributes.append(Attribute(f.name, shown, doc_line(f), default))
             elif default:
-                attributes.append(Attribute(f.name, annotation(f), doc_line(f), default, in_class=False))
+                attributes.append(Attribute(f.name, shown, doc_line(f), default, in_class=False))
                 after_default = True
             else:
-                attributes.append(
-                    Attribute(f.name, annotation(f), doc_line(f), "REQUIRED" if after_default else "", False)
-                )
+                attributes.append(Attribute(f.name, shown, doc_line(f), "REQUIRED" if after_default else "", False))
         return attributes
 
     def helper(self, f: SpecField) -> None:
@@ -429,18 +431,29 @@ class PackageCode:
             Attribute(e.name, "bytes | None", one_line(f"{e.description or e.name} ({e.size} bytes, or None)"), "None")
             for e in optional
         ]
-        code = ClassCode(message.class_name, doc, "Message", [*self.attributes(fields), *extras])
+        partial = self.protocol.framing.partial_values(message.direction)
+        code = ClassCode(message.class_name, doc, "Message", [*self.attributes(fields, partial=partial), *extras])
         code.class_vars = [
             f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
             f"COMMAND: ClassVar[str] = {message.command!r}",
             f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
-        code.to_fields = [f"{spec_key(f.name)}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
+        code.to_fields = [
+            f"{spec_key(f.name)}: None if self.{f.name} is None else {self.to_json(f, 'self.' + f.name)},"
+            if f.name in partial
+            else f"{spec_key(f.name)}: {self.to_json(f, 'self.' + f.name)},"
+            for f in fields
+        ]
         code.to_fields += [f"{e.name!r}: None if self.{e.name} is None else self.{e.name}.hex(' ')," for e in optional]
         code.read_from(
             [
-                *(self.from_json(f) for f in fields),
+                *(
+                    Calls(f"None if data.get({f.name!r}) is None else {self.from_json(f)}", (), self.from_json(f))
+                    if f.name in partial
+                    else self.from_json(f)
+                    for f in fields
+                ),
                 *(Calls(f"_optional_bytes(data, {e.name!r}, where)", ["_optional_bytes"]) for e in optional),
             ]
         )
@@ -954,7 +967,12 @@ class PackageCode:
             if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
                 self.check_scalar(f, field_read("m", f.name), body, where)
                 continue
-            self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
+            if f.name in self.protocol.framing.partial_values(message.direction):  # None: a layout without it
+                checks: Block = []
+                self.check_scalar(f, field_read("m", f.name), checks, where, also=elements[f.name].broadcast)
+                body.append(If(f"{field_read('m', f.name)} is not None", tuple(checks)))
+            else:
+                self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
             frame_values.append(Simple(field_read("m", f.name)))
         self.check_error_bits(
             message,

@@ -164,6 +164,19 @@ class Framing:
         """The layout of a direction by its name ("": the first), where layouts are chosen by command."""
         return next((layout for layout in self.alternatives[direction] if layout.name == name), self.layouts[direction])
 
+    def partial_values(self, direction: Direction) -> frozenset[str]:
+        """The frame values of a direction that some alternative layout does not carry (the Pololu form's device
+        number beside the compact form): a message holds None for them when its frame's layout has no such element,
+        and is sent in the layout carrying exactly the values it gives."""
+        layouts = self.alternatives.get(direction, ())
+        if self.by_command:  # each message carries its own layout's values
+            return frozenset()
+        return frozenset(
+            e.name
+            for e in (layouts[0].value_elements if layouts else ())
+            if any(all(x.name != e.name for x in layout.elements) for layout in layouts)
+        )
+
     @property
     def from_request(self) -> bool:
         """Some reply's checksum takes in bytes of its request: decoding it needs the request."""
@@ -186,8 +199,11 @@ class Framing:
 
     @property
     def classic(self) -> bool:
-        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code."""
-        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
+        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code (not where
+        a frame value is in some layouts only: the frame engine's, which gives None for it in the others)."""
+        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts) and not any(
+            self.partial_values(direction) for direction in self.alternatives
+        )
 
 
 @frozen

@@ -99,9 +99,7 @@ class FramingPass(FieldResolver):
                         "without a header may stand beside them if it starts with its command element: it takes "
                         "the frames no header starts)",
                     )
-                values = {tuple(e.name for e in layout.value_elements) for layout in layouts}
-                if len(values) != 1:
-                    raise self.fail((*path, "layouts"), "alternative layouts must carry the same address/status")
+                alternatives[direction] = self.carried_values(layouts, (*path, "layouts"))
                 with_command = [layout.name for layout in layouts if layout.has_command]
                 if with_command and len(with_command) != len(layouts):
                     without = [layout.name for layout in layouts if not layout.has_command]
@@ -125,6 +123,31 @@ class FramingPass(FieldResolver):
             turnaround=self.seconds_or_characters(value, "turnaround", path),
             by_command=by_command,
         )
+
+    def carried_values(self, layouts: list[FrameLayout], path: Path) -> list[FrameLayout]:
+        """Alternative layouts told apart by their header may carry different frame values (the Pololu form's
+        device number beside the compact form without one): every message of the direction carries each of them
+        (`value_elements`, the union in order of first appearance), None where its frame's layout has no such element;
+        an element of one name is the same value in every layout that has it."""
+        union: dict[str, FrameElement] = {}
+        for layout in layouts:
+            for element in layout.value_elements:
+                seen = union.setdefault(element.name, element)
+                if (seen.role, seen.type, seen.minimum, seen.maximum) != (
+                    element.role,
+                    element.type,
+                    element.minimum,
+                    element.maximum,
+                ):
+                    raise self.fail(
+                        path,
+                        f"frame value {element.name} must be the same role, type and range in every layout that "
+                        "carries it",
+                    )
+        values = tuple(union.values())
+        if all(tuple(e.name for e in layout.value_elements) == tuple(union) for layout in layouts):
+            return layouts  # the same values in every layout: each keeps its own elements
+        return [replace(layout, value_elements=values) for layout in layouts]
 
     def seconds_or_characters(self, value: dict[str, Any], key: str, path: Path) -> float:
         """`gap` or `turnaround`: a time to wait, never negative (the grammar has checked it is a finite number)."""

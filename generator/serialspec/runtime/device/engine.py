@@ -789,7 +789,9 @@ class Engine(FaultInjection):
                 state, per = command.counts[name]
                 values[name] = int(device.get(state) / per)
             elif name == device.spec.address and not device.spec.echo_address:
-                values[name] = device.id  # a device answers with its own id, also to a broadcast
+                # a device answers with its own id, also to a broadcast; to a request in a form without an address
+                # (None: the Pololu compact form's), in the form without one
+                values[name] = None if name in given and given[name] is None else device.id
             elif name in device.spec.status:
                 values[name] = device.get(device.spec.status[name])
             elif any(key.startswith(name + ".") for key in (*self.spec.reply, *device.spec.status)):

@@ -187,6 +187,8 @@ def codec_lines(
         lines.append(f"    error_flag={error.flag:#04x},")
     if error is not None and direction == Direction.RESPONSE and error.status:
         lines.append(f"    error_status=({error.status!r}, {error.bits:#04x}),")
+    if protocol.framing.partial_values(direction):  # a frame value some layout does not carry: None there
+        lines.append("    partial=True,")
     if protocol.framing.by_request(direction):  # each reply class's layout: read with the request's reply class
         lines.append("    replies={")
         lines += [

@@ -253,9 +253,17 @@ CASES: dict[str, Case] = {
             "p": {"type": "i32", "encoding": "nibbles", "range": [-32768, -1], "default": -2},  # (negative, always)
             "d": {"type": "i8", "encoding": "nibbles"},
             "o": {"type": "u24", "encoding": "nibbles", "endian": "big", "range": [0, 4000]},
-            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64 (a value of 32 bits, exact in Lua)
+            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64
             "u": {"type": "u64", "encoding": "nibbles", "endian": "big"},
             "i": {"type": "i64", "encoding": "nibbles", "range": [-(2**31), -1], "default": -3},
+            # seven_bit's 56 bits: past a Lua number's 53 exact ones (none of these values is a double)
+            "s": {"type": "u64", "encoding": "seven_bit", "range": [2**56 - 7, 2**56 - 1], "default": 2**56 - 1},
+            "m": {
+                "type": "i64",
+                "encoding": "seven_bit",
+                "range": [-(2**55) + 1, -(2**55) + 3],
+                "default": -(2**55) + 1,
+            },
             "g": {"type": "group", "count": 2, "fields": {"n": {"type": "i16", "encoding": "nibbles"}}},
         }
     ),

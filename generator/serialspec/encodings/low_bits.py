@@ -154,8 +154,8 @@ VARIANT = (
     "`bend` 8192 as 00 40 (7 bits a byte, the low ones first). Decoding refuses a byte with a bit above its value's "
     "set (`the high nibble of a byte of zoom is set`), encoding a value outside the range before a byte is written "
     "(`pan = 40000 is outside its range -32768..32767`). Every output takes them: the codec, stream parser, client "
-    "and simulator, the construct structs, the markdown reference, C (not on a 64-bit type: refused in one line) and "
-    "the Wireshark dissector. Such a field is a plain number: no `const`, `bits`, `flags` or `value`, not a count or "
+    "and simulator, the construct structs, the markdown reference, C (a u64's or i64's word a uint64_t) and the "
+    "Wireshark dissector. Such a field is a plain number: no `const`, `bits`, `flags` or `value`, not a count or "
     "size (each refused in one line).",
 )
 

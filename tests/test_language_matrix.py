@@ -1671,6 +1671,14 @@ C_FRAMES: dict[str, tuple[dict[str, Any], list[bytes], bytes]] = {
         [bytes(5), b"", bytes(range(1, 253)), b"\x00\x01\x00", bytes(range(1, 250)) + b"\x00", b"\xfe"],
         b"\xaa\x00\xaa\x03",
     ),
+    # the length's forms at their edges: 255 in one byte (data 2), 258 in the long form (data 3: 256 and 257 cannot
+    # be: 3 more bytes of length), 511 (data 256: the C's data room, P_..._MAX), the marker 01 and FF in the data and
+    # the garbage
+    "frame: extended length (a marker, then a u16), counting itself": (
+        {"pad": " ".join(["01"] * 251)},
+        [b"", b"\x01", b"\xff\x01", b"\x01\xff\x01", bytes(range(256)), b"\x01" * 4],
+        b"\x01\x01\x00\xff",
+    ),
 }
 
 

@@ -506,8 +506,18 @@ def test_noisy_streams_byte_by_byte_and_in_random_pieces_give_what_python_gives(
 # twice, a repeat's values of the wrong number, a part without `named`, a value not of its kind)
 REPORT = ("=3|P=1.5,2|LV=7", "", "=", "=x", "|", "|LV=7|LV=8", "|Q=1", "|LV", "|P=1", "|P=,", "|P=1,2,3", "|=3")
 REPORT += ("|S=1,N,2,S", "|S=1,N,2", "|S=1,N,2,S,3,N,4,S", "|TX=a=b,c|S=,", "=1|RP=2")
+# (and what a careless reader gets wrong: signs, spaces, leading zeros, numbers past 32 bits, texts past the text
+# room, bytes past ASCII, empty parts)
+REPORT += ("=-0", "=+3", "= 3", "=3 ", "=03", "|LV=7|P=1.5,2|S=1,N", "|P=1e5,2", "|P=1.55,2")
+REPORT += ("|P=.5,2", "|P=-.5,2", "|P=5.,2", "|TX=" + "a" * 300, "|S=", "|S=1,N,2,X", "|LV=007", "|LV=4294967303")
+REPORT += ("|LV=-4294967296", "|TX=\x80\xff", "|TX=a|TX=b", "|P=1,2|", "||LV=1", "|LV=1|", "|S=1,N,,S", "|P=nan,2")
+REPORT += ("|P=inf,1", "|LV=0x10", "|LV=1_0")
 MOVE = ("1T2SD3.5", "T2", "SD-1T5", "", "1T2T3", "1X2", "1..2", "+1T-0", "T")
 WORDS = (";Y2;X1.5", "", ";", ";X", ";Q1", ";X1;X2", ";Wa=b", ";Y2;;X1", ";W")
+MOVE += ("1SD2T3", "1S2", "1TSD3", "1T-", "1T2SD", "1T2SD3.5SD4", "-0T0", "99999999999T1", "1T2 ", "T1SD2MV3")
+MOVE += ("1T2SD-", "1T2SD.", "1T2SD+.5", "1T4294967297", "1T-2147483649", "1T2147483648", "1SD1e3")
+WORDS += (";X1e3", ";X-", ";Y+2", ";X1;Y", ";W" + "z" * 400)
+WORDS += (";Y2147483648", ";Y-2147483649", ";X1.5;Y2;", ";;", ";Y 2")
 LABELLED = {
     "c_text_matrix": [("response", f"5<ARP{rest}>") for rest in REPORT]
     + [("response", "5<AXY=3>"), ("response", "<BRP=1|LV=2>")]

@@ -129,3 +129,64 @@ def test_the_reference_names_the_python_attribute(tmp_path: Path) -> None:
     assert serialspec_main(["generate", str(spec), "--out", str(tmp_path / "out"), "--target", "markdown"]) == 0
     docs = (tmp_path / "out" / "docs" / "keyworded.md").read_text("utf-8")
     assert "| class |" in docs.replace("`", "") and "(In Python: `class_`.)" in docs
+
+
+# a group's items named as the message's fields, before and after the group: items of one size read in a loop that
+# converts them (sign_magnitude, nibbles), items of varying size read one by one, a group in a group's items
+SHARED = """
+protocol: shared_names
+title: Items named as their message's fields
+byte_order: little
+serial: {baudrate: 115200}
+framing:
+  elements:
+    header: {role: header, value: "AA 55"}
+    code: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+commands:
+  probe:
+    code: 1
+    request:
+      fields:
+        n: u8
+        k: {type: i16, encoding: nibbles}
+        s: u8
+        g: {type: group, count: 2, fields: {n: {type: i8, encoding: sign_magnitude}, k: {type: i16, encoding: nibbles}}}
+        v: {type: group, count: 2, fields: {n: {type: i8, encoding: sign_magnitude}, d: {type: bytes, size: s}}}
+        w: {type: group, count: 1, fields: {s: u8, d: {type: bytes, size: s}}}
+        h:
+          type: group
+          count: 1
+          fields:
+            n: {type: i8, encoding: sign_magnitude}
+            g: {type: group, count: 1, fields: {n: {type: i8, encoding: sign_magnitude}}}
+        tail: {type: bytes, size: rest}
+"""
+
+
+def test_items_named_as_their_message_s_fields_keep_each_value() -> None:
+    """A group item's value was decoded into the local of the message's field of its name, which then took the last
+    item's value (n = -1 for 3 here); a group in an item packed into the list of the message's group of its name
+    (g's bytes were h.g's). An item's size is its own earlier field where it has one of that name (w's s), else the
+    field before its group (v's items' d: the message's s)."""
+    from serialspec.backends.python import files as python_files
+    from serialspec.backends.python.memory import imported
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    protocol = resolve(load_text(SHARED, "shared.yaml"))
+    modules = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+    with imported(protocol.name, modules, "the shared names test") as package:
+        fields = {
+            "n": 3,
+            "k": 100,
+            "g": [{"n": 1, "k": -1}, {"n": -2, "k": -3}],
+            "v": [{"n": -1, "d": "0a"}, {"n": 0, "d": "0b"}],
+            "w": [{"d": "0c 0d"}],
+            "h": [{"n": -5, "g": [{"n": -6}]}],
+            "tail": "01 02 03",
+        }
+        message = package.ProbeRequest.from_fields(fields)
+        decoded = package.decode(package.encode(message), "request")
+        assert decoded == message and decoded.to_fields() == fields

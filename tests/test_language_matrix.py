@@ -253,9 +253,17 @@ CASES: dict[str, Case] = {
             "p": {"type": "i32", "encoding": "nibbles", "range": [-32768, -1], "default": -2},  # (negative, always)
             "d": {"type": "i8", "encoding": "nibbles"},
             "o": {"type": "u24", "encoding": "nibbles", "endian": "big", "range": [0, 4000]},
-            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64 (a value of 32 bits, exact in Lua)
+            # 8-byte words: C's uint64_t, the dissector's UInt64/Int64
             "u": {"type": "u64", "encoding": "nibbles", "endian": "big"},
             "i": {"type": "i64", "encoding": "nibbles", "range": [-(2**31), -1], "default": -3},
+            # seven_bit's 56 bits: past a Lua number's 53 exact ones (none of these values is a double)
+            "s": {"type": "u64", "encoding": "seven_bit", "range": [2**56 - 7, 2**56 - 1], "default": 2**56 - 1},
+            "m": {
+                "type": "i64",
+                "encoding": "seven_bit",
+                "range": [-(2**55) + 1, -(2**55) + 3],
+                "default": -(2**55) + 1,
+            },
             "g": {"type": "group", "count": 2, "fields": {"n": {"type": "i16", "encoding": "nibbles"}}},
         }
     ),
@@ -1677,6 +1685,14 @@ C_FRAMES: dict[str, tuple[dict[str, Any], list[bytes], bytes]] = {
         # FE: the sum is 00, so the span ends in 00 (its COBS form ends 01 01: the parsers sized it one byte short)
         [bytes(5), b"", bytes(range(1, 253)), b"\x00\x01\x00", bytes(range(1, 250)) + b"\x00", b"\xfe"],
         b"\xaa\x00\xaa\x03",
+    ),
+    # the length's forms at their edges: 255 in one byte (data 2), 258 in the long form (data 3: 256 and 257 cannot
+    # be: 3 more bytes of length), 511 (data 256: the C's data room, P_..._MAX), the marker 01 and FF in the data and
+    # the garbage
+    "frame: extended length (a marker, then a u16), counting itself": (
+        {"pad": " ".join(["01"] * 251)},
+        [b"", b"\x01", b"\xff\x01", b"\x01\xff\x01", bytes(range(256)), b"\x01" * 4],
+        b"\x01\x01\x00\xff",
     ),
 }
 

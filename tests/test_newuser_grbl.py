@@ -17,7 +17,7 @@ from typing import Any
 
 import pytest
 from serialspec.lang import load_protocol
-from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 
 BASE = """
 protocol: grbl
@@ -283,6 +283,8 @@ def test_a_protocol_without_a_talker_shows_none(example: ModuleType) -> None:
     assert repr(error) == "ErrorResponse(code=3)"
     assert grbl.ErrorResponse(3) == error and grbl.encode(grbl.ErrorResponse(3)) == b"error:3\r\n"
     assert "talker" not in describe("grbl", grbl, b"error:3\r\n")
+    with pytest.raises(EncodeError, match=r"^error: talker 'GP' given, but these frames carry no talker$"):
+        grbl.CODEC.framing.encode("error", {"code": "3"}, "GP", direction="response")
 
 
 def test_codes_with_question_marks_compile_as_c99_without_trigraphs(tmp_path: Path) -> None:

@@ -111,8 +111,11 @@ def child(element: ET.Element, name: str) -> ET.Element:
 
 
 def number(text: str) -> int | float:
-    value = float(text)
-    return int(value) if "." not in text and "e" not in text else value
+    """An integer exactly (a 64-bit one passes a float's 53 bits), else a float."""
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)
 
 
 def value(field: Field, shown: ET.Element, abbr: str) -> Any:

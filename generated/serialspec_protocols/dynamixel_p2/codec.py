@@ -160,13 +160,13 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 4
     v_servos_list = []
     while o < end:
-        v_id = buf[o]
+        i1_id = buf[o]
         o += 1
         if end - o < v_length:
             raise DecodeError('sync_write request' + f': data needs {v_length} bytes, {end - o} left')
-        v_data = buf[o : o + v_length]
+        i1_data = buf[o : o + v_length]
         o += v_length
-        item = _new(ServosItem, (v_id, v_data))
+        item = _new(ServosItem, (i1_id, i1_data))
         v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:
@@ -187,13 +187,13 @@ def _decode_bulk_write_request(buf: bytes, o: int, end: int, id: int) -> BulkWri
     while o < end:
         if end - o < 5:
             raise DecodeError('bulk_write request' + f': id needs 5 bytes, {end - o} left')
-        v_id, v_address, v_length = _S_U8_U16_U16.unpack_from(buf, o)
+        i1_id, i1_address, i1_length = _S_U8_U16_U16.unpack_from(buf, o)
         o += 5
-        if end - o < v_length:
-            raise DecodeError('bulk_write request' + f': data needs {v_length} bytes, {end - o} left')
-        v_data = buf[o : o + v_length]
-        o += v_length
-        item = _new(WritesItem, (v_id, v_address, v_data))
+        if end - o < i1_length:
+            raise DecodeError('bulk_write request' + f': data needs {i1_length} bytes, {end - o} left')
+        i1_data = buf[o : o + i1_length]
+        o += i1_length
+        item = _new(WritesItem, (i1_id, i1_address, i1_data))
         v_writes_list.append(item)
     v_writes = tuple(v_writes_list)
     if o != end:

@@ -508,9 +508,9 @@ def _decode_sync_command_request(buf: bytes, o: int, end: int) -> SyncCommandReq
     for _ in range(v_count):
         if end - o < v_block_size:
             raise DecodeError('sync_command request' + f': content needs {v_block_size} bytes, {end - o} left')
-        v_content = buf[o : o + v_block_size]
+        i1_content = buf[o : o + v_block_size]
         o += v_block_size
-        item = _new(BlocksItem, (v_content,))
+        item = _new(BlocksItem, (i1_content,))
         v_blocks_list.append(item)
     v_blocks = tuple(v_blocks_list)
     if o != end:

@@ -104,13 +104,13 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 2
     v_servos_list = []
     while o < end:
-        v_id = buf[o]
+        i1_id = buf[o]
         o += 1
         if end - o < v_data_length:
             raise DecodeError('sync_write request' + f': data needs {v_data_length} bytes, {end - o} left')
-        v_data = buf[o : o + v_data_length]
+        i1_data = buf[o : o + v_data_length]
         o += v_data_length
-        item = _new(ServosItem, (v_id, v_data))
+        item = _new(ServosItem, (i1_id, i1_data))
         v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:

@@ -1805,8 +1805,8 @@ local function add_scalar(f, tree, range, scope)
   elseif f.low_bits then
     value = low_bits(range, f.big, f.low_bits)
     if value == nil then error(string.format("%s of a byte of %s is set", f.low_bits.flaw, f.name), 0) end
-    local wide = SIZES[f.type] == 8 and (f.low_bits.signed and Int64(value) or UInt64(value)) -- a 64-bit field's
-    item = tree:add(f.pf, range, wide or value)
+    item = tree:add(f.pf, range, value) -- (an 8-byte field's: its UInt64 or Int64, exact)
+    if SIZES[f.type] == 8 then value = value:tonumber() end -- hereafter a Lua number, as `number` gives a u64's
   else
     item = add(tree, f.pf, range, f.big)
   end

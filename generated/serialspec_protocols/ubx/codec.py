@@ -203,9 +203,9 @@ def _decode_mon_ver_response(buf: bytes, o: int, end: int) -> MonVerResponse:
     if (end - o) % 30:
         raise DecodeError('mon_ver response' + f': {end - o} bytes do not split into extensions items of 30')
     n = end - o
-    for v_extension, in _S_B30.iter_unpack(buf[o : o + n]):
-        v_extension = _unpad_text(v_extension, 0, 'extension', 'mon_ver response')
-        item = _new(ExtensionsItem, (v_extension,))
+    for i1_extension, in _S_B30.iter_unpack(buf[o : o + n]):
+        i1_extension = _unpad_text(i1_extension, 0, 'extension', 'mon_ver response')
+        item = _new(ExtensionsItem, (i1_extension,))
         v_extensions_list.append(item)
     v_extensions = tuple(v_extensions_list)
     return _new(MonVerResponse, (v_sw_version, v_hw_version, v_extensions))

@@ -154,8 +154,8 @@ VARIANT = (
     "`bend` 8192 as 00 40 (7 bits a byte, the low ones first). Decoding refuses a byte with a bit above its value's "
     "set (`the high nibble of a byte of zoom is set`), encoding a value outside the range before a byte is written "
     "(`pan = 40000 is outside its range -32768..32767`). Every output takes them: the codec, stream parser, client "
-    "and simulator, the construct structs, the markdown reference, C (not on a 64-bit type: refused in one line) and "
-    "the Wireshark dissector. Such a field is a plain number: no `const`, `bits`, `flags` or `value`, not a count or "
+    "and simulator, the construct structs, the markdown reference, C (a u64's or i64's word a uint64_t) and the "
+    "Wireshark dissector. Such a field is a plain number: no `const`, `bits`, `flags` or `value`, not a count or "
     "size (each refused in one line).",
 )
 
@@ -193,16 +193,23 @@ def Nibbles(subcon: Any, size: int, signed: bool = False) -> Any:  # noqa: N802 
 
 #: The Wireshark dissector's function (arithmetic only: Wireshark's Lua may be 5.2, without bitwise operators): the
 #: value of the field's bytes (`range`, `big`: the highest group first), `e.bits` bits a byte (`e` the field's
-#: `low_bits`, LowBits.lua_field), read byte by byte (a u64's word passes a Lua number's 53 exact bits, its value of
-#: nibbles does not); nil when a byte has a bit above them set.
+#: `low_bits`, LowBits.lua_field), read byte by byte; an 8-byte word's value is a UInt64 (Int64 when signed), as
+#: seven_bit's 56 bits pass a Lua number's 53 exact ones (2^56 - 1 would show as 2^56); nil when a byte has a bit
+#: above them set.
 LUA = """local function low_bits(range, big, e)
   local size = range:len()
-  local value = 0
+  local value = size == 8 and UInt64(0) or 0
   for i = 0, size - 1 do
     local byte = range(big and i or size - 1 - i, 1):uint()
     if byte >= 2 ^ e.bits then return nil end
     value = value * 2 ^ e.bits + byte
   end
-  if e.signed and value >= 2 ^ (e.bits * size - 1) then value = value - 2 ^ (e.bits * size) end
+  local top = 2 ^ (e.bits * size - 1) -- (a power of two: exact as a number)
+  if size == 8 then
+    if not e.signed then return value end
+    if value >= UInt64(top) then return Int64(value) - Int64(2 * top) end
+    return Int64(value)
+  end
+  if e.signed and value >= top then value = value - 2 * top end
   return value
 end"""

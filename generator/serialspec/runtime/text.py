@@ -463,6 +463,8 @@ class TextFraming:
             sentence = self.sentence(code, direction)
         except DecodeError as exc:
             raise EncodeError(str(exc)) from None
+        if talker and not self.talker:
+            raise EncodeError(f"{sentence.where}: talker {talker!r} given, but these frames carry no talker")
         if len(talker) != self.talker or (self.talkers and talker not in self.talkers):
             allowed = ", ".join(self.talkers) if self.talkers else f"{self.talker} characters"
             raise EncodeError(f"{sentence.where}: talker {talker!r} is not one of {allowed}")

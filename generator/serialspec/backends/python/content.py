@@ -250,6 +250,10 @@ class PackageCode:
         self.packing: set[str] = set()  # the runtime.packing functions the bodies call (as _<name>)
         self._seen_classes: set[str] = set()
         self._straight: dict[Direction, StraightLayouts | None] = {}
+        # the decoders' locals: a prefix and the fields named in it, innermost last: `v_` a message's fields, `i1_` its
+        # groups' items', `i2_` theirs (an item's local named as a field before its group would overwrite that
+        # field's value); a name is its innermost field's (an item's size may be a field before its group)
+        self._scopes: list[tuple[str, frozenset[str]]] = [("v_", frozenset())]
         for message in protocol.messages():
             self.message(message)
 
@@ -675,9 +679,8 @@ class PackageCode:
         body.append(Advance(size))
         return values
 
-    @staticmethod
-    def local(f: SpecField) -> str:
-        return f"v_{f.name}"
+    def local(self, f: SpecField) -> str:
+        return f"{self._scopes[-1][0]}{f.name}"
 
     def bit_member(self, f: Scalar, run: str, body: Block) -> None:
         """A member of a bit run from the run's bytes (`run`, read by the struct): the run is one integer, made by
@@ -793,9 +796,19 @@ class PackageCode:
                 assert_never(f)
 
     def decode_group(self, f: Group, body: Block, where: str) -> str:
-        """A group's items: unpacked in a loop where they have one size, else read one by one."""
-        item_fields = list(f.fields)
+        """A group's items: unpacked in a loop where they have one size, else read one by one; their locals in a
+        scope of their own (see `_scopes`)."""
         value = self.local(f)
+        count = None if f.count == "rest" else self.count_value(f, f.count, body, where)  # (a field of the message)
+        self._scopes.append((f"i{len(self._scopes)}_", frozenset(i.name for i in f.fields)))
+        try:
+            return self.group_items(f, value, count, body, where)
+        finally:
+            self._scopes.pop()
+
+    def group_items(self, f: Group, value: str, count: str | None, body: Block, where: str) -> str:
+        """decode_group's items, `count` the expression of their count (None: the rest of the content)."""
+        item_fields = list(f.fields)
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
         start_list = Code(f"{value}_list = []")
         body.append(start_list)
@@ -808,7 +821,6 @@ class PackageCode:
                 body.append(If(f"(end - o) % {f.item_size}", (split,), cursor=True))
                 body.append(Code("n = end - o", cursor=True))
             else:
-                count = self.count_value(f, f.count, body, where)
                 body.append(Code(f"n = {count} * {f.item_size}"))
                 reason = f"content too short for its count ({{{count}}} {f.name})"
                 body.append(Needs("n", f"DecodeError({where} + f': {reason}')"))
@@ -837,10 +849,9 @@ class PackageCode:
             body.append(Advance("n"))
             return value
         # items of varying size: read them one by one
-        if f.count == "rest":
+        if count is None:
             header, cursor = "while o < end", True
         else:
-            count = self.count_value(f, f.count, body, where)
             header, cursor = f"for _ in range({count})", False
         inner: Block = []
         # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
@@ -946,7 +957,8 @@ class PackageCode:
         return value
 
     def local_named(self, name: str) -> str:
-        return f"v_{name}"
+        prefix = next((prefix for prefix, names in reversed(self._scopes) if name in names), self._scopes[0][0])
+        return f"{prefix}{name}"
 
     # --- encoding -------------------------------------------------------------------------------------------------
 
@@ -1284,7 +1296,9 @@ class PackageCode:
         item_body: Block = []
         parts = self.encode_fields(list(f.fields), f.class_name, item, item_body, where)
         packed = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
-        body.append(Code(f"parts_{f.name} = []"))
-        item_body.append(Code(f"parts_{f.name}.append({packed})", lists=packed_lists(parts)))
+        # (a group in an item: its list named by its depth, apart from a group of its name further out)
+        joined = f"parts_{f.name}" if obj == "m" else f"parts{obj.count('item')}_{f.name}"
+        body.append(Code(f"{joined} = []"))
+        item_body.append(Code(f"{joined}.append({packed})", lists=packed_lists(parts)))
         body.append(Loop(f"for {item} in {expr}", tuple(item_body), variable=item))
-        return f"b''.join(parts_{f.name})"
+        return f"b''.join({joined})"

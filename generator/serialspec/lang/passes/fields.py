@@ -682,8 +682,10 @@ class FieldResolver(Pass):
         return name, (int(number) if sign == "+" else -int(number)) if number else 0
 
     def size_field(self, size: str, name: str, siblings: list[Field], parent: list[Field] | None, path: Path) -> None:
-        """Bytes sized by a field: inside a group, a field before the group sets the size of every item."""
-        if parent is not None and any(f.name == size for f in parent):
+        """Bytes sized by a field: an earlier field of the item (or the message); inside a group, where the item has
+        no field of that name, a field before the group sets the size of every item (the innermost field of a name
+        is the one meant, as the generated decoders read it)."""
+        if parent is not None and any(f.name == size for f in parent) and not any(f.name == size for f in siblings):
             self.derive(size, ("size", name), parent, path)
         else:
             self.derive(size, ("size", name), siblings, path)
